@@ -1,0 +1,65 @@
+# Every dependency of grbd comes from a Debian 12 package and is found here, once, for all
+# chapters. A missing one stops the configure step and names the package to install;
+# scripts/setup installs them all.
+
+set(GRBD_MISSING_PACKAGES "")
+macro(grbd_require found what debian_package)
+  if(NOT ${found})
+    list(APPEND GRBD_MISSING_PACKAGES ${debian_package})
+    message(SEND_ERROR "grbd needs ${what}: install the Debian package '${debian_package}' "
+                       "(sudo apt-get install ${debian_package}), or run scripts/setup.")
+  endif()
+endmacro()
+
+# Eigen 3.4 (linear algebra; header only).
+find_package(Eigen3 3.4 QUIET NO_MODULE)
+grbd_require(Eigen3_FOUND "Eigen >= 3.4" libeigen3-dev)
+
+# SUNDIALS 6.4 (CVODE and ARKODE, chapter 3).
+find_package(SUNDIALS 6.4 QUIET CONFIG)
+grbd_require(SUNDIALS_FOUND "SUNDIALS >= 6.4" libsundials-dev)
+
+# Open MPI (chapter 8).
+find_package(MPI QUIET COMPONENTS C CXX)
+grbd_require(MPI_FOUND "MPI (Open MPI) for C and C++" "libopenmpi-dev openmpi-bin")
+find_program(GRBD_MPIEXEC NAMES mpiexec mpirun HINTS ${MPI_HOME} PATH_SUFFIXES bin)
+grbd_require(GRBD_MPIEXEC "the mpiexec launcher" openmpi-bin)
+
+# Parallel HDF5 built against Open MPI (chapters 7 and 8).
+set(HDF5_PREFER_PARALLEL TRUE)
+find_package(HDF5 QUIET COMPONENTS C)
+if(HDF5_FOUND AND NOT HDF5_IS_PARALLEL)
+  message(SEND_ERROR "grbd needs the parallel (MPI) build of HDF5, but found a serial one "
+                     "(${HDF5_C_INCLUDE_DIRS}): install the Debian package 'libhdf5-openmpi-dev'.")
+endif()
+grbd_require(HDF5_FOUND "parallel HDF5" libhdf5-openmpi-dev)
+
+# GoogleTest and Google Benchmark.
+if(GRBD_BUILD_TESTS)
+  find_package(GTest QUIET)
+  grbd_require(GTest_FOUND "GoogleTest" libgtest-dev)
+endif()
+find_package(benchmark QUIET)
+grbd_require(benchmark_FOUND "Google Benchmark" libbenchmark-dev)
+
+# Python 3 runs the exercise generator and the grading script (standard library only).
+find_package(Python3 QUIET COMPONENTS Interpreter)
+grbd_require(Python3_FOUND "Python 3" python3)
+
+# gnuplot draws the figures of the chapters from the data the demo programs write.
+find_program(GRBD_GNUPLOT gnuplot)
+grbd_require(GRBD_GNUPLOT "gnuplot (the figures of the book)" gnuplot-nox)
+
+# Doxygen 1.9 and a local MathJax 2 for the book, which must render without a network.
+if(GRBD_BUILD_BOOK)
+  find_package(Doxygen 1.9 QUIET)
+  grbd_require(DOXYGEN_FOUND "Doxygen >= 1.9" doxygen)
+  find_path(GRBD_MATHJAX_DIR MathJax.js PATHS /usr/share/javascript/mathjax /usr/share/mathjax
+            NO_DEFAULT_PATH)
+  grbd_require(GRBD_MATHJAX_DIR "a local copy of MathJax 2" "libjs-mathjax fonts-mathjax")
+endif()
+
+if(GRBD_MISSING_PACKAGES)
+  list(JOIN GRBD_MISSING_PACKAGES " " _grbd_missing)
+  message(FATAL_ERROR "Missing dependencies. On Debian 12: sudo apt-get install ${_grbd_missing}")
+endif()

@@ -1,0 +1,25 @@
+# Compiler flags shared by every grbd target.
+add_library(grbd_flags INTERFACE)
+target_compile_options(grbd_flags INTERFACE -Wall -Wextra -Wpedantic
+                                            $<$<BOOL:${GRBD_WERROR}>:-Werror>)
+if(GRBD_SANITIZE)
+  target_compile_options(grbd_flags INTERFACE -fsanitize=address,undefined -fno-omit-frame-pointer
+                                              -fno-sanitize-recover=all)
+  target_link_options(grbd_flags INTERFACE -fsanitize=address,undefined)
+endif()
+
+# The exercises of every chapter, read from the markers in solutions/: a list of "N.M" strings.
+function(grbd_chapter_exercises chapter_dir out_var)
+  file(GLOB _files CONFIGURE_DEPENDS ${PROJECT_SOURCE_DIR}/solutions/${chapter_dir}/*.cpp)
+  set(_ids "")
+  foreach(_file IN LISTS _files)
+    file(STRINGS ${_file} _lines REGEX "BEGIN EXERCISE [0-9]+\\.[0-9]+")
+    foreach(_line IN LISTS _lines)
+      string(REGEX MATCH "BEGIN EXERCISE ([0-9]+\\.[0-9]+)" _m "${_line}")
+      list(APPEND _ids ${CMAKE_MATCH_1})
+    endforeach()
+  endforeach()
+  list(REMOVE_DUPLICATES _ids)
+  list(SORT _ids COMPARE NATURAL)
+  set(${out_var} ${_ids} PARENT_SCOPE)
+endfunction()

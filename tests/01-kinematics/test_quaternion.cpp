@@ -1,0 +1,300 @@
+// Chapter 1: the quaternion algebra ℍ (Exercises 1.1 and 1.2, and the core functions of
+// quaternion.hpp).
+//
+// The independent reference throughout is the 2 × 2 complex representation ℍ ⊂ ℂ²ˣ²
+// (complex_matrix, from_complex_matrix): its product is Eigen's complex matrix product, which
+// shares no code with product(), phi_L() or phi_R(). The QuaternionAlgebra suite checks that
+// reference itself on the basis i, j, k, without using product().
+//
+// Tolerances: the algebra identities are checked on inputs with coordinates in [−2, 2), where
+// every coordinate of a product is a sum of four products of O(1) numbers. The error of such a
+// sum is a few ulps of |P||Q|, so 1e-14 relative to |P||Q| (about 45 ulps) is tight and safe.
+
+#include <gtest/gtest.h>
+
+#include <Eigen/LU>  // determinant()
+#include <cmath>
+#include <complex>
+
+#include "grbd/core/error.hpp"
+#include "grbd/kinematics/quaternion.hpp"
+#include "grbd_test/random.hpp"
+
+namespace {
+
+using grbd::Matrix4;
+using grbd::Vector4;
+using grbd::kinematics::complex_matrix;
+using grbd::kinematics::from_complex_matrix;
+using grbd::kinematics::Quaternion;
+
+constexpr int kSamples = 10000;
+constexpr double kRel = 1e-14;  // relative tolerance of algebra identities on O(1) inputs
+
+/// Reference product through ℂ²ˣ²: complex_matrix is an algebra homomorphism.
+Quaternion reference_product(const Quaternion& P, const Quaternion& Q) {
+  return from_complex_matrix(complex_matrix(P) * complex_matrix(Q));
+}
+
+/// max-norm of the coordinate difference.
+double distance(const Quaternion& P, const Quaternion& Q) {
+  return (P.coeffs() - Q.coeffs()).cwiseAbs().maxCoeff();
+}
+
+const Quaternion one{1, 0, 0, 0};
+const Quaternion qi{0, 1, 0, 0};
+const Quaternion qj{0, 0, 1, 0};
+const Quaternion qk{0, 0, 0, 1};
+
+}  // namespace
+
+// ----------------------------------------------------------------------------------------------
+// Exercise 1.1: the quaternion product
+// ----------------------------------------------------------------------------------------------
+
+// Reference: Hamilton's defining relations. The products of basis elements involve only 0 and
+// ±1, so they are exact in floating point: compared with ==.
+TEST(Exercise1_1, BasisRelations) {
+  const Quaternion minus_one{-1, 0, 0, 0};
+  EXPECT_EQ((qi * qi).coeffs(), minus_one.coeffs()) << "i² = −1";
+  EXPECT_EQ((qj * qj).coeffs(), minus_one.coeffs()) << "j² = −1";
+  EXPECT_EQ((qk * qk).coeffs(), minus_one.coeffs()) << "k² = −1";
+  EXPECT_EQ((qi * qj * qk).coeffs(), minus_one.coeffs()) << "ijk = −1";
+  EXPECT_EQ((qi * qj).coeffs(), qk.coeffs()) << "ij = k";
+  EXPECT_EQ((qj * qi).coeffs(), (-qk).coeffs()) << "ji = −k";
+  EXPECT_EQ((qj * qk).coeffs(), qi.coeffs()) << "jk = i";
+  EXPECT_EQ((qk * qj).coeffs(), (-qi).coeffs()) << "kj = −i";
+  EXPECT_EQ((qk * qi).coeffs(), qj.coeffs()) << "ki = j";
+  EXPECT_EQ((qi * qk).coeffs(), (-qj).coeffs()) << "ik = −j";
+  for (const Quaternion& e : {one, qi, qj, qk}) {
+    EXPECT_EQ((one * e).coeffs(), e.coeffs()) << "1 is the identity";
+    EXPECT_EQ((e * one).coeffs(), e.coeffs()) << "1 is the identity";
+  }
+}
+
+// Reference: the 2 × 2 complex matrix product (complex_matrix is an algebra homomorphism).
+TEST(Exercise1_1, EqualsComplexMatrixProduct) {
+  grbd::test::Random rng(101);
+  double worst = 0.0;
+  for (int n = 0; n < kSamples; ++n) {
+    const Quaternion P = rng.quaternion();
+    const Quaternion Q = rng.quaternion();
+    worst = std::max(worst, distance(P * Q, reference_product(P, Q)) / (P.norm() * Q.norm()));
+  }
+  EXPECT_LE(worst, kRel);
+}
+
+// Reference: associativity of ℍ, (PQ)R = P(QR).
+TEST(Exercise1_1, IsAssociative) {
+  grbd::test::Random rng(102);
+  double worst = 0.0;
+  for (int n = 0; n < kSamples; ++n) {
+    const Quaternion P = rng.quaternion();
+    const Quaternion Q = rng.quaternion();
+    const Quaternion R = rng.quaternion();
+    const double scale = P.norm() * Q.norm() * R.norm();
+    worst = std::max(worst, distance((P * Q) * R, P * (Q * R)) / scale);
+  }
+  EXPECT_LE(worst, kRel);
+}
+
+// Reference: ℍ is a normed division algebra, |PQ| = |P||Q|.
+TEST(Exercise1_1, NormIsMultiplicative) {
+  grbd::test::Random rng(103);
+  double worst = 0.0;
+  for (int n = 0; n < kSamples; ++n) {
+    const Quaternion P = rng.quaternion();
+    const Quaternion Q = rng.quaternion();
+    const double expected = P.norm() * Q.norm();
+    worst = std::max(worst, std::abs((P * Q).norm() - expected) / expected);
+  }
+  EXPECT_LE(worst, kRel);
+}
+
+// Reference: conjugation reverses products, conj(PQ) = Q̄ P̄, and P P̄ = |P|² (a real number).
+TEST(Exercise1_1, ConjugateReversesProductsAndGivesTheNorm) {
+  grbd::test::Random rng(104);
+  double worst = 0.0;
+  for (int n = 0; n < kSamples; ++n) {
+    const Quaternion P = rng.quaternion();
+    const Quaternion Q = rng.quaternion();
+    const double scale = P.norm() * Q.norm();
+    worst = std::max(worst, distance((P * Q).conjugate(), Q.conjugate() * P.conjugate()) / scale);
+    const Quaternion norm2{P.squared_norm(), 0, 0, 0};
+    worst = std::max(worst, distance(P * P.conjugate(), norm2) / P.squared_norm());
+  }
+  EXPECT_LE(worst, kRel);
+}
+
+// Reference: distributivity, P(Q + R) = PQ + PR, and ℝ-linearity.
+TEST(Exercise1_1, IsBilinear) {
+  grbd::test::Random rng(105);
+  double worst = 0.0;
+  for (int n = 0; n < kSamples; ++n) {
+    const Quaternion P = rng.quaternion();
+    const Quaternion Q = rng.quaternion();
+    const Quaternion R = rng.quaternion();
+    const double s = rng.uniform();
+    const double scale = P.norm() * (Q.norm() + R.norm());
+    worst = std::max(worst, distance(P * (Q + R), P * Q + P * R) / scale);
+    worst = std::max(worst, distance((s * P) * Q, s * (P * Q)) / scale);
+  }
+  EXPECT_LE(worst, kRel);
+}
+
+// ----------------------------------------------------------------------------------------------
+// Exercise 1.2: the multiplication matrices φ_L and φ_R
+// ----------------------------------------------------------------------------------------------
+
+// Reference: the complex matrix product. φ_L(P) K(Q) = K(PQ) = φ_R(Q) K(P).
+TEST(Exercise1_2, MultiplicationMatricesReproduceTheProduct) {
+  grbd::test::Random rng(201);
+  double worst_L = 0.0;
+  double worst_R = 0.0;
+  for (int n = 0; n < kSamples; ++n) {
+    const Quaternion P = rng.quaternion();
+    const Quaternion Q = rng.quaternion();
+    const Vector4 K_PQ = reference_product(P, Q).coeffs();
+    const double scale = P.norm() * Q.norm();
+    const Vector4 by_L = grbd::kinematics::phi_L(P) * Q.coeffs();
+    const Vector4 by_R = grbd::kinematics::phi_R(Q) * P.coeffs();
+    worst_L = std::max(worst_L, (by_L - K_PQ).cwiseAbs().maxCoeff() / scale);
+    worst_R = std::max(worst_R, (by_R - K_PQ).cwiseAbs().maxCoeff() / scale);
+  }
+  EXPECT_LE(worst_L, kRel) << "φ_L(P) K(Q) = K(PQ)";
+  EXPECT_LE(worst_R, kRel) << "φ_R(Q) K(P) = K(PQ)";
+}
+
+// Reference: associativity of ℍ, (PX)Q = P(XQ) for every X, is the commutation of the left and
+// right multiplications.
+TEST(Exercise1_2, LeftAndRightMultiplicationsCommute) {
+  grbd::test::Random rng(202);
+  double worst = 0.0;
+  for (int n = 0; n < kSamples; ++n) {
+    const Quaternion P = rng.quaternion();
+    const Quaternion Q = rng.quaternion();
+    const Matrix4 L = grbd::kinematics::phi_L(P);
+    const Matrix4 R = grbd::kinematics::phi_R(Q);
+    worst = std::max(worst, (L * R - R * L).cwiseAbs().maxCoeff() / (P.norm() * Q.norm()));
+  }
+  EXPECT_LE(worst, kRel);
+}
+
+// Reference: |PQ| = |P||Q| for every Q means φ_L(P)/|P| and φ_R(P)/|P| are orthogonal:
+// φ_L(P)ᵀ φ_L(P) = φ_R(P)ᵀ φ_R(P) = |P|² I.
+TEST(Exercise1_2, MultiplicationMatricesAreScaledOrthogonal) {
+  grbd::test::Random rng(203);
+  double worst = 0.0;
+  for (int n = 0; n < kSamples; ++n) {
+    const Quaternion P = rng.quaternion();
+    const Matrix4 L = grbd::kinematics::phi_L(P);
+    const Matrix4 R = grbd::kinematics::phi_R(P);
+    const Matrix4 expected = P.squared_norm() * Matrix4::Identity();
+    worst =
+        std::max(worst, (L.transpose() * L - expected).cwiseAbs().maxCoeff() / P.squared_norm());
+    worst =
+        std::max(worst, (R.transpose() * R - expected).cwiseAbs().maxCoeff() / P.squared_norm());
+  }
+  EXPECT_LE(worst, kRel);
+}
+
+// Reference: K(1·Q) = K(Q) and K(P·1) = K(P): φ_L(1) = φ_R(1) = I exactly; the first column of
+// φ_L(P) and of φ_R(P) is K(P) exactly (it is the product with 1).
+TEST(Exercise1_2, IdentityAndFirstColumn) {
+  EXPECT_EQ(grbd::kinematics::phi_L(one), Matrix4::Identity());
+  EXPECT_EQ(grbd::kinematics::phi_R(one), Matrix4::Identity());
+  grbd::test::Random rng(204);
+  for (int n = 0; n < 100; ++n) {
+    const Quaternion P = rng.quaternion();
+    EXPECT_EQ(Vector4(grbd::kinematics::phi_L(P).col(0)), P.coeffs());
+    EXPECT_EQ(Vector4(grbd::kinematics::phi_R(P).col(0)), P.coeffs());
+  }
+}
+
+// ----------------------------------------------------------------------------------------------
+// Core: the complex representation, inverse, normalisation, rotations of E⁴
+// ----------------------------------------------------------------------------------------------
+
+// Reference: Hamilton's relations, checked on the complex matrices themselves (this validates
+// the reference used by every other test of this file). Exact: entries are 0 and ±1, ±i.
+TEST(QuaternionAlgebra, ComplexMatricesObeyHamiltonsRelations) {
+  const Eigen::Matrix2cd I = complex_matrix(one);
+  const Eigen::Matrix2cd Mi = complex_matrix(qi);
+  const Eigen::Matrix2cd Mj = complex_matrix(qj);
+  const Eigen::Matrix2cd Mk = complex_matrix(qk);
+  EXPECT_EQ(I, Eigen::Matrix2cd::Identity());
+  EXPECT_EQ(Mi * Mi, -I);
+  EXPECT_EQ(Mj * Mj, -I);
+  EXPECT_EQ(Mk * Mk, -I);
+  EXPECT_EQ(Mi * Mj * Mk, -I);
+  EXPECT_EQ(Mi * Mj, Mk);
+  EXPECT_EQ(Mj * Mi, -Mk);
+}
+
+// Reference: det of the complex matrix is |P|² (it is p0² + p1² + p2² + p3²), and
+// from_complex_matrix inverts complex_matrix exactly.
+TEST(QuaternionAlgebra, ComplexMatrixRoundTripAndDeterminant) {
+  grbd::test::Random rng(301);
+  double worst = 0.0;
+  for (int n = 0; n < kSamples; ++n) {
+    const Quaternion P = rng.quaternion();
+    const Eigen::Matrix2cd M = complex_matrix(P);
+    EXPECT_EQ(from_complex_matrix(M).coeffs(), P.coeffs());
+    const std::complex<double> det = M.determinant();
+    worst = std::max(worst, std::abs(det - P.squared_norm()) / P.squared_norm());
+  }
+  EXPECT_LE(worst, kRel);
+}
+
+// Reference: P P⁻¹ = P⁻¹ P = 1, computed with complex matrices (independent of product()).
+TEST(QuaternionAlgebra, InverseIsTwoSided) {
+  grbd::test::Random rng(302);
+  double worst = 0.0;
+  for (int n = 0; n < kSamples; ++n) {
+    const Quaternion P = rng.quaternion();
+    worst = std::max(worst, distance(reference_product(P, P.inverse()), one));
+    worst = std::max(worst, distance(reference_product(P.inverse(), P), one));
+  }
+  // |P| ∈ (0, 4): |P||P⁻¹| = 1, so the products are O(1); for |P| ≪ 1 the division by |P|² is
+  // exact to an ulp and the cancellation is of O(1) terms. 1e-14 absolute.
+  EXPECT_LE(worst, kRel);
+}
+
+// Reference: |P/|P|| = 1, and the direction is unchanged.
+TEST(QuaternionAlgebra, NormalizedIsUnitAndParallel) {
+  grbd::test::Random rng(303);
+  double worst = 0.0;
+  for (int n = 0; n < kSamples; ++n) {
+    const Quaternion P = rng.quaternion();
+    const Quaternion p = P.normalized();
+    worst = std::max(worst, std::abs(p.norm() - 1.0));
+    worst = std::max(worst, distance(P.norm() * p, P) / P.norm());
+  }
+  EXPECT_LE(worst, kRel);
+}
+
+// Reference: the documented precondition P ≠ 0 (a NaN coordinate is rejected as well).
+TEST(QuaternionAlgebra, ZeroHasNoInverseAndNoDirection) {
+  const Quaternion zero{0, 0, 0, 0};
+  EXPECT_THROW((void)zero.inverse(), grbd::InvalidArgument);
+  EXPECT_THROW((void)zero.normalized(), grbd::InvalidArgument);
+  const Quaternion nan{std::nan(""), 0, 0, 0};
+  EXPECT_THROW((void)nan.inverse(), grbd::InvalidArgument);
+  EXPECT_THROW((void)nan.normalized(), grbd::InvalidArgument);
+}
+
+// Reference: P X Q through complex matrices; for unit P, Q the map is an isometry of E⁴ = ℍ.
+TEST(RotateE4, EqualsTwoSidedProductAndIsAnIsometry) {
+  grbd::test::Random rng(304);
+  double worst = 0.0;
+  for (int n = 0; n < kSamples; ++n) {
+    const Quaternion P = rng.unit_quaternion();
+    const Quaternion Q = rng.unit_quaternion();
+    const Quaternion X = rng.quaternion();
+    const Vector4 y = grbd::kinematics::rotate_E4(P, X.coeffs(), Q);
+    const Quaternion expected = reference_product(reference_product(P, X), Q);
+    worst = std::max(worst, (y - expected.coeffs()).cwiseAbs().maxCoeff() / X.norm());
+    worst = std::max(worst, std::abs(y.norm() - X.norm()) / X.norm());
+  }
+  EXPECT_LE(worst, kRel);
+}
