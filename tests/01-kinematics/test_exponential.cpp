@@ -19,8 +19,11 @@
 #include "grbd/kinematics/rotation.hpp"
 #include "grbd/kinematics/skew.hpp"
 #include "grbd_test/random.hpp"
+#include "grbd_test/references.hpp"
 
 namespace {
+
+using namespace grbd::test;  // NOLINT: the shared reference formulas
 
 using grbd::Matrix3;
 using grbd::Vector3;
@@ -32,28 +35,6 @@ using grbd::kinematics::skew;
 
 constexpr int kSamples = 10000;
 constexpr double pi = std::numbers::pi;
-
-Quaternion reference_product(const Quaternion& P, const Quaternion& Q) {
-  using grbd::kinematics::complex_matrix;
-  return grbd::kinematics::from_complex_matrix(complex_matrix(P) * complex_matrix(Q));
-}
-
-/// exp(a n) = (cos a, sin a n) for a unit vector n.
-Quaternion closed_form_exp(const Vector3& n, double a) {
-  return {std::cos(a), Vector3(std::sin(a) * n)};
-}
-
-double distance(const Quaternion& P, const Quaternion& Q) {
-  return (P.coeffs() - Q.coeffs()).cwiseAbs().maxCoeff();
-}
-
-double max_abs(const Matrix3& A) { return A.cwiseAbs().maxCoeff(); }
-
-/// The matrix exponential of θ̃ by Eigen (Padé + scaling and squaring).
-Matrix3 expm(const Vector3& theta) {
-  const Matrix3 theta_tilde = skew(theta);
-  return theta_tilde.exp();
-}
 
 }  // namespace
 

@@ -19,8 +19,11 @@
 #include "grbd/core/error.hpp"
 #include "grbd/kinematics/quaternion.hpp"
 #include "grbd_test/random.hpp"
+#include "grbd_test/references.hpp"
 
 namespace {
+
+using namespace grbd::test;  // NOLINT: the shared reference formulas
 
 using grbd::Matrix4;
 using grbd::Vector4;
@@ -30,16 +33,6 @@ using grbd::kinematics::Quaternion;
 
 constexpr int kSamples = 10000;
 constexpr double kRel = 1e-14;  // relative tolerance of algebra identities on O(1) inputs
-
-/// Reference product through ℂ²ˣ²: complex_matrix is an algebra homomorphism.
-Quaternion reference_product(const Quaternion& P, const Quaternion& Q) {
-  return from_complex_matrix(complex_matrix(P) * complex_matrix(Q));
-}
-
-/// max-norm of the coordinate difference.
-double distance(const Quaternion& P, const Quaternion& Q) {
-  return (P.coeffs() - Q.coeffs()).cwiseAbs().maxCoeff();
-}
 
 const Quaternion one{1, 0, 0, 0};
 const Quaternion qi{0, 1, 0, 0};

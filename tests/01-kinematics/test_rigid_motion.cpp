@@ -22,8 +22,11 @@
 #include "grbd/kinematics/rotation.hpp"
 #include "grbd/kinematics/skew.hpp"
 #include "grbd_test/random.hpp"
+#include "grbd_test/references.hpp"
 
 namespace {
+
+using namespace grbd::test;  // NOLINT: the shared reference formulas
 
 using grbd::Matrix3;
 using grbd::Matrix76;
@@ -40,32 +43,11 @@ using grbd::kinematics::skew;
 constexpr double pi = std::numbers::pi;
 constexpr double kEps = std::numeric_limits<double>::epsilon();
 
-Quaternion reference_product(const Quaternion& P, const Quaternion& Q) {
-  using grbd::kinematics::complex_matrix;
-  return grbd::kinematics::from_complex_matrix(complex_matrix(P) * complex_matrix(Q));
-}
-
-/// exp(0, v) in closed form (cos|v|, sin|v| v/|v|), for v ≠ 0.
-Quaternion closed_form_exp(const Vector3& v) {
-  const double a = v.norm();
-  if (a == 0.0) return Quaternion::identity();
-  return {std::cos(a), Vector3(std::sin(a) / a * v)};
-}
-
 /// The exact motion for constant u = (v, ω), from q0 at t = 0.
 Vector7 exact_motion(const Vector7& q0, const Vector6& u, double t) {
   const Vector3 r = q0.head<3>() + t * u.head<3>();
   const Quaternion p = reference_product(orientation(q0), closed_form_exp(0.5 * t * u.tail<3>()));
   return make_q(r, p);
-}
-
-/// Classical axis–angle matrix of the rotation vector θ.
-Matrix3 axis_angle_matrix(const Vector3& theta) {
-  const double a = theta.norm();
-  if (a == 0.0) return Matrix3::Identity();
-  const Vector3 n = theta / a;
-  return std::cos(a) * Matrix3::Identity() + std::sin(a) * skew(n) +
-         (1.0 - std::cos(a)) * n * n.transpose();
 }
 
 struct Sample {

@@ -23,8 +23,11 @@
 #include "grbd/kinematics/rotation.hpp"
 #include "grbd/kinematics/skew.hpp"
 #include "grbd_test/random.hpp"
+#include "grbd_test/references.hpp"
 
 namespace {
+
+using namespace grbd::test;  // NOLINT: the shared reference formulas
 
 using grbd::Matrix3;
 using grbd::Vector3;
@@ -37,29 +40,9 @@ constexpr int kSamples = 10000;
 constexpr double kTol = 1e-14;
 constexpr double pi = std::numbers::pi;
 
-Quaternion reference_product(const Quaternion& P, const Quaternion& Q) {
-  using grbd::kinematics::complex_matrix;
-  return grbd::kinematics::from_complex_matrix(complex_matrix(P) * complex_matrix(Q));
-}
-
-double max_abs(const Matrix3& A) { return A.cwiseAbs().maxCoeff(); }
-
-/// The rotation by `angle` about the unit vector n, in the classical axis–angle form (Euler,
-/// Rodrigues), sharing no code with the quaternion functions.
-Matrix3 axis_angle_matrix(const Vector3& n, double angle) {
-  return std::cos(angle) * Matrix3::Identity() + std::sin(angle) * skew(n) +
-         (1.0 - std::cos(angle)) * n * n.transpose();
-}
-
 /// The unit quaternion of the rotation by `angle` about the unit vector n, written out.
 Quaternion axis_angle_quaternion(const Vector3& n, double angle) {
   return {std::cos(0.5 * angle), Vector3(std::sin(0.5 * angle) * n)};
-}
-
-/// Distance of p from the nearer of ±expected.
-double distance_up_to_sign(const Quaternion& p, const Quaternion& expected) {
-  return std::min((p.coeffs() - expected.coeffs()).cwiseAbs().maxCoeff(),
-                  (p.coeffs() + expected.coeffs()).cwiseAbs().maxCoeff());
 }
 
 }  // namespace
