@@ -15,6 +15,8 @@ using Vector7 = Eigen::Matrix<double, 7, 1>;     ///< 7 × 1, coordinates q = (I
 using Matrix3 = Eigen::Matrix3d;                 ///< 3 × 3, e.g. A_IK, inertia tensors
 using Matrix4 = Eigen::Matrix4d;                 ///< 4 × 4, e.g. phi_L(P), phi_R(Q)
 using Matrix43 = Eigen::Matrix<double, 4, 3>;    ///< 4 × 3, e.g. the quaternion rate matrix
+using Matrix6 = Eigen::Matrix<double, 6, 6>;     ///< 6 × 6, e.g. the mass matrix M
+using Matrix36 = Eigen::Matrix<double, 3, 6>;    ///< 3 × 6, e.g. the Jacobian of a material point
 using Matrix76 = Eigen::Matrix<double, 7, 6>;    ///< 7 × 6, the kinematic map F(q)
 
 }  // namespace grbd

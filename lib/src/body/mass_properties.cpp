@@ -1,0 +1,170 @@
+/// \file
+/// \brief Mass properties of closed triangle meshes (the sum over faces of the exercise
+/// tetrahedron_integrals()), principal axes, and the closed forms of primitive solids.
+
+#include "grbd/body/mass_properties.hpp"
+
+#include <Eigen/Eigenvalues>  // SelfAdjointEigenSolver
+#include <Eigen/LU>           // determinant()
+#include <cmath>
+#include <cstdio>
+#include <numbers>
+#include <string>
+
+#include "grbd/core/error.hpp"
+
+namespace grbd::body {
+
+namespace {
+
+/// A double with all 17 significant digits, for error messages.
+std::string format(double x) {
+  char buffer[32];
+  std::snprintf(buffer, sizeof buffer, "%.17g", x);
+  return buffer;
+}
+
+void require_positive(const char* function, const char* name, double x) {
+  if (!(x > 0.0) || !std::isfinite(x)) {
+    throw InvalidArgument(std::string(function) + ": expected a finite " + name + " > 0, found " +
+                          format(x));
+  }
+}
+
+/// Uniform density ρ, mass m = ρV and Θ about the centre of mass at the origin.
+MassProperties centred(double volume, double density, const Vector3& diagonal_per_mass) {
+  MassProperties props;
+  props.volume = volume;
+  props.mass = density * volume;
+  props.M_Theta_S = (props.mass * diagonal_per_mass).asDiagonal();
+  return props;
+}
+
+}  // namespace
+
+//! [volume integrals]
+VolumeIntegrals volume_integrals(const TriangleMesh& mesh) {
+  // Divergence theorem: the solid is the signed sum of the tetrahedra (0, a, b, c) over its
+  // faces. Their parts outside the solid are covered once positively and once negatively, so
+  // they cancel exactly as the mesh is closed and consistently oriented.
+  VolumeIntegrals integrals;
+  for (Eigen::Index f = 0; f < mesh.F.rows(); ++f) {
+    integrals += tetrahedron_integrals(mesh.V.row(mesh.F(f, 0)).transpose(),
+                                       mesh.V.row(mesh.F(f, 1)).transpose(),
+                                       mesh.V.row(mesh.F(f, 2)).transpose());
+  }
+  return integrals;
+}
+//! [volume integrals]
+
+MassProperties mass_properties(const TriangleMesh& mesh, double density, std::string_view source) {
+  require_closed_oriented(mesh, source);
+  if (!(density > 0.0) || !std::isfinite(density)) {
+    throw InvalidArgument("mass_properties (" + std::string(source) +
+                          "): expected a finite density > 0, found " + format(density));
+  }
+  // Integrate about the centre c of the bounding box, not about the origin of M: for a body far
+  // from the origin the moments about the origin are dominated by m|r_S|², and Steiner's shift
+  // back to S would cancel most of their digits. Θ_S does not depend on where we integrate.
+  const Vector3 c = 0.5 * (mesh.V.colwise().minCoeff() + mesh.V.colwise().maxCoeff()).transpose();
+  const VolumeIntegrals integrals = volume_integrals(transformed(mesh, Matrix3::Identity(), -c));
+  MassProperties props;
+  props.volume = integrals.volume;
+  props.mass = density * integrals.volume;
+  props.M_r_S = c + integrals.first / integrals.volume;
+  props.M_Theta_S = inertia_about_centre_of_mass(integrals, density);
+  return props;
+}
+
+//! [principal axes]
+PrincipalAxes principal_axes(const Matrix3& M_Theta_S) {
+  const double size = M_Theta_S.cwiseAbs().maxCoeff();
+  const double asymmetry = (M_Theta_S - M_Theta_S.transpose()).cwiseAbs().maxCoeff();
+  if (!M_Theta_S.allFinite() || !(asymmetry <= 1e-8 * size)) {
+    throw InvalidArgument(
+        "principal_axes: expected a finite symmetric inertia tensor, found max |Θ − Θᵀ| = " +
+        format(asymmetry) + " for max |Θ| = " + format(size));
+  }
+  // Eigen's self-adjoint solver returns the eigenvalues in ascending order and orthonormal
+  // eigenvectors as the columns of A_MK, so that Θ = A_MK diag(K_Theta) A_MKᵀ.
+  const Eigen::SelfAdjointEigenSolver<Matrix3> solver(0.5 * (M_Theta_S + M_Theta_S.transpose()));
+  if (solver.info() != Eigen::Success) {
+    throw Error("principal_axes: the symmetric eigensolver did not converge");
+  }
+  PrincipalAxes axes;
+  axes.K_Theta = solver.eigenvalues();
+  axes.A_MK = solver.eigenvectors();
+  // Each eigenvector is defined up to its sign; flipping the third makes K right-handed, so
+  // that A_MK is a rotation (det = +1) and can be turned into a quaternion.
+  if (axes.A_MK.determinant() < 0.0) axes.A_MK.col(2) *= -1.0;
+  return axes;
+}
+//! [principal axes]
+
+MassProperties sphere_mass_properties(double radius, double density) {
+  require_positive("sphere_mass_properties", "radius", radius);
+  require_positive("sphere_mass_properties", "density", density);
+  const double volume = 4.0 / 3.0 * std::numbers::pi * radius * radius * radius;
+  return centred(volume, density, Vector3::Constant(0.4 * radius * radius));
+}
+
+MassProperties box_mass_properties(const Vector3& half_extents, double density) {
+  require_positive("box_mass_properties", "half extent a", half_extents.x());
+  require_positive("box_mass_properties", "half extent b", half_extents.y());
+  require_positive("box_mass_properties", "half extent c", half_extents.z());
+  require_positive("box_mass_properties", "density", density);
+  const Vector3 s = half_extents.cwiseAbs2();  // (a², b², c²)
+  return centred(8.0 * half_extents.prod(), density,
+                 Vector3(s.y() + s.z(), s.x() + s.z(), s.x() + s.y()) / 3.0);
+}
+
+MassProperties cylinder_mass_properties(double radius, double height, double density) {
+  require_positive("cylinder_mass_properties", "radius", radius);
+  require_positive("cylinder_mass_properties", "height", height);
+  require_positive("cylinder_mass_properties", "density", density);
+  const double R2 = radius * radius;
+  const double transverse = (3.0 * R2 + height * height) / 12.0;
+  return centred(std::numbers::pi * R2 * height, density,
+                 Vector3(transverse, transverse, 0.5 * R2));
+}
+
+MassProperties capsule_mass_properties(double radius, double height, double density) {
+  require_positive("capsule_mass_properties", "radius", radius);
+  if (!(height >= 0.0) || !std::isfinite(height)) {
+    throw InvalidArgument(
+        "capsule_mass_properties: expected a finite height ≥ 0 of the straight part, found " +
+        format(height));
+  }
+  require_positive("capsule_mass_properties", "density", density);
+  const double R = radius;
+  const double h = height;
+  const double m_cylinder = density * std::numbers::pi * R * R * h;
+  const double m_hemisphere = density * 2.0 / 3.0 * std::numbers::pi * R * R * R;
+  // Each hemisphere has (2/5) m_h R² about any axis through the centre of its flat face; its
+  // centroid lies 3R/8 beyond that face, (h/2 + 3R/8) from S, and two Steiner shifts (to its
+  // centroid and out to S) give m_h (2R²/5 + h²/4 + 3hR/8) about a transverse axis through S.
+  const double axial = 0.5 * m_cylinder * R * R + 2.0 * 0.4 * m_hemisphere * R * R;
+  const double transverse = m_cylinder * (3.0 * R * R + h * h) / 12.0 +
+                            2.0 * m_hemisphere * (0.4 * R * R + 0.25 * h * h + 0.375 * h * R);
+  MassProperties props;
+  props.volume = std::numbers::pi * R * R * (h + 4.0 / 3.0 * R);
+  props.mass = m_cylinder + 2.0 * m_hemisphere;
+  props.M_Theta_S = Vector3(transverse, transverse, axial).asDiagonal();
+  return props;
+}
+
+MassProperties torus_mass_properties(double R, double r, double density) {
+  require_positive("torus_mass_properties", "centre-line radius R", R);
+  require_positive("torus_mass_properties", "tube radius r", r);
+  require_positive("torus_mass_properties", "density", density);
+  if (!(r <= R)) {
+    // For r > R the tube overlaps itself near the axis and Pappus's volume counts it twice.
+    throw InvalidArgument("torus_mass_properties: expected a tube radius r ≤ R, found r = " +
+                          format(r) + ", R = " + format(R));
+  }
+  const double diametral = 0.5 * R * R + 0.625 * r * r;
+  return centred(2.0 * std::numbers::pi * std::numbers::pi * R * r * r, density,
+                 Vector3(diametral, diametral, R * R + 0.75 * r * r));
+}
+
+}  // namespace grbd::body

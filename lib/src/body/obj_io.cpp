@@ -1,0 +1,299 @@
+/// \file
+/// \brief A strict Wavefront OBJ reader and writer for triangle meshes.
+///
+/// The reader accepts exactly the subset documented in triangle_mesh.hpp and stops at the first
+/// thing it does not understand, with the file, the line, what it expected and what it found:
+/// a mesh silently read wrong is worse than no mesh.
+
+#include <algorithm>
+#include <array>
+#include <cerrno>
+#include <charconv>
+#include <cmath>
+#include <cstdint>
+#include <fstream>
+#include <iterator>
+#include <limits>
+#include <sstream>
+#include <string>
+#include <system_error>
+#include <vector>
+
+#include "grbd/body/triangle_mesh.hpp"
+
+namespace grbd::body {
+
+namespace {
+
+/// At most this many characters of an offending token go into a message.
+constexpr std::size_t kMaxQuoted = 40;
+
+/// `text` made printable for an error message: control and non-ASCII bytes as \xNN, long tokens
+/// cut short with "...".
+std::string quoted(std::string_view text) {
+  std::string out;
+  for (std::size_t i = 0; i < text.size() && i < kMaxQuoted; ++i) {
+    const auto byte = static_cast<unsigned char>(text[i]);
+    if (byte >= 0x20 && byte < 0x7f) {
+      out.push_back(static_cast<char>(byte));
+    } else {
+      constexpr char hex[] = "0123456789abcdef";
+      out += "\\x";
+      out.push_back(hex[byte >> 4]);
+      out.push_back(hex[byte & 0xf]);
+    }
+  }
+  if (text.size() > kMaxQuoted) out += "...";
+  return "'" + out + "'";
+}
+
+bool is_blank(char c) { return c == ' ' || c == '\t'; }
+
+/// The whitespace-separated tokens of one line (spaces and tabs only: any other byte, a control
+/// character included, belongs to a token and is then reported as found).
+std::vector<std::string_view> tokenize(std::string_view line) {
+  std::vector<std::string_view> tokens;
+  std::size_t i = 0;
+  while (i < line.size()) {
+    while (i < line.size() && is_blank(line[i])) ++i;
+    const std::size_t start = i;
+    while (i < line.size() && !is_blank(line[i])) ++i;
+    if (i > start) tokens.push_back(line.substr(start, i - start));
+  }
+  return tokens;
+}
+
+/// Parses the OBJ text of one file; `name` is the file name for messages.
+class ObjParser {
+ public:
+  explicit ObjParser(std::string name) : name_(std::move(name)) {}
+
+  TriangleMesh parse(std::string_view text) {
+    // A UTF-8 byte order mark, which some editors write, is not part of the first statement.
+    if (text.starts_with("\xEF\xBB\xBF")) text.remove_prefix(3);
+    line_ = 0;
+    while (!text.empty()) {
+      const std::size_t end = text.find('\n');
+      std::string_view line = text.substr(0, end);
+      text.remove_prefix(end == std::string_view::npos ? text.size() : end + 1);
+      ++line_;
+      if (line.ends_with('\r')) line.remove_suffix(1);  // Windows line ends
+      if (const std::size_t hash = line.find('#'); hash != std::string_view::npos) {
+        line = line.substr(0, hash);  // a comment runs to the end of the line
+      }
+      line_text_ = line.substr(0, line.find_last_not_of(" \t") + 1);  // npos + 1 = 0
+      line_text_.remove_prefix(std::min(line_text_.find_first_not_of(" \t"), line_text_.size()));
+      statement(tokenize(line));
+    }
+    if (faces_.empty()) {
+      line_ = std::max<std::size_t>(line_, 1);
+      fail("at least one face ('f i j k')",
+           "end of file after " + std::to_string(vertices_.size()) + " vertices and no 'f' line",
+           /*quote=*/false);
+    }
+    TriangleMesh mesh;
+    mesh.V.resize(static_cast<Eigen::Index>(vertices_.size()), 3);
+    for (std::size_t i = 0; i < vertices_.size(); ++i) {
+      mesh.V.row(static_cast<Eigen::Index>(i)) = vertices_[i];
+    }
+    mesh.F.resize(static_cast<Eigen::Index>(faces_.size()), 3);
+    for (std::size_t f = 0; f < faces_.size(); ++f) {
+      for (int k = 0; k < 3; ++k) {
+        mesh.F(static_cast<Eigen::Index>(f), k) = faces_[f][static_cast<std::size_t>(k)];
+      }
+    }
+    return mesh;
+  }
+
+ private:
+  [[noreturn]] void fail(std::string_view expected, std::string_view found,
+                         bool quote = true) const {
+    throw MeshError(name_ + ":" + std::to_string(line_) + ": expected " + std::string(expected) +
+                    ", found " + (quote ? quoted(found) : std::string(found)));
+  }
+
+  void statement(const std::vector<std::string_view>& tokens) {
+    if (tokens.empty()) return;
+    const std::string_view keyword = tokens[0];
+    if (keyword == "v") {
+      vertex(tokens);
+    } else if (keyword == "f") {
+      face(tokens);
+    } else if (keyword == "vt" || keyword == "vn" || keyword == "vp" || keyword == "o" ||
+               keyword == "g" || keyword == "s" || keyword == "usemtl" || keyword == "mtllib") {
+      // Texture coordinates, normals, names, groups, smoothing and materials carry nothing that
+      // the mass properties need.
+    } else {
+      fail(
+          "a statement 'v', 'f', 'vt', 'vn', 'vp', 'o', 'g', 's', 'usemtl', 'mtllib' or a "
+          "comment",
+          keyword);
+    }
+  }
+
+  double number(std::string_view token) const {
+    std::string_view digits = token;
+    // std::from_chars does not take a leading '+', which OBJ writers sometimes emit.
+    if (digits.size() > 1 && digits[0] == '+' && digits[1] != '-' && digits[1] != '+') {
+      digits.remove_prefix(1);
+    }
+    double x = 0.0;
+    const auto [end, error] = std::from_chars(digits.data(), digits.data() + digits.size(), x);
+    if (error != std::errc() || end != digits.data() + digits.size() || !std::isfinite(x)) {
+      fail("a finite decimal number", token);
+    }
+    return x;
+  }
+
+  void vertex(const std::vector<std::string_view>& tokens) {
+    if (tokens.size() < 4) fail("three coordinates 'v x y z [w]'", line_text_);
+    if (tokens.size() > 5) {
+      fail("'v x y z [w]' to end the line", tokens[5]);
+    }
+    Eigen::RowVector3d x;
+    for (int k = 0; k < 3; ++k) x[k] = number(tokens[static_cast<std::size_t>(k) + 1]);
+    if (tokens.size() == 5) number(tokens[4]);  // the weight w is checked, but not used
+    vertices_.push_back(x);
+  }
+
+  /// An optional texture or normal index of a vertex reference: checked, not used.
+  void attribute_index(std::string_view part, std::string_view token) const {
+    int value = 0;
+    const auto [end, error] = std::from_chars(part.data(), part.data() + part.size(), value);
+    if (error != std::errc() || end != part.data() + part.size() || value == 0) {
+      fail("a vertex reference 'i', 'i/t', 'i//n' or 'i/t/n' with non-zero integers", token);
+    }
+  }
+
+  /// The zero-based vertex index of one vertex reference of an 'f' line.
+  int vertex_index(std::string_view token) const {
+    constexpr std::string_view form = "a vertex reference 'i', 'i/t', 'i//n' or 'i/t/n'";
+    const std::size_t slash = token.find('/');
+    const std::string_view index = token.substr(0, slash);
+    if (slash != std::string_view::npos) {
+      const std::string_view rest = token.substr(slash + 1);
+      const std::size_t second = rest.find('/');
+      if (second == std::string_view::npos) {
+        attribute_index(rest, token);  // i/t
+      } else {
+        const std::string_view t = rest.substr(0, second);
+        const std::string_view n = rest.substr(second + 1);
+        if (!t.empty()) attribute_index(t, token);  // i/t/n, or i//n with t empty
+        attribute_index(n, token);
+      }
+    }
+    int i = 0;
+    const auto [end, error] = std::from_chars(index.data(), index.data() + index.size(), i);
+    if (error != std::errc() || end != index.data() + index.size()) fail(form, token);
+    // Positive indices count from 1 at the first vertex of the file, negative ones back from the
+    // last vertex read so far (−1 is the latest).
+    const auto count = static_cast<std::int64_t>(vertices_.size());
+    const std::int64_t zero_based = i > 0 ? std::int64_t{i} - 1 : count + i;
+    if (i == 0 || zero_based < 0 || zero_based >= count) {
+      const std::string range =
+          count == 0 ? std::string("none (no vertex read yet)")
+                     : "[1, " + std::to_string(count) + "] or [-" + std::to_string(count) + ", -1]";
+      fail("a vertex index in " + range, token);
+    }
+    return static_cast<int>(zero_based);
+  }
+
+  void face(const std::vector<std::string_view>& tokens) {
+    if (tokens.size() < 4) fail("a face of at least three vertices 'f i j k ...'", line_text_);
+    std::vector<int> polygon;
+    polygon.reserve(tokens.size() - 1);
+    for (std::size_t k = 1; k < tokens.size(); ++k) polygon.push_back(vertex_index(tokens[k]));
+    // A polygon v0 v1 … v(n−1) becomes the fan (v0, v(k), v(k+1)), which keeps its orientation.
+    for (std::size_t k = 1; k + 1 < polygon.size(); ++k) {
+      faces_.push_back({polygon[0], polygon[k], polygon[k + 1]});
+    }
+  }
+
+  std::string name_;
+  std::size_t line_ = 0;
+  std::string_view line_text_;  ///< the current line, comment removed, for messages
+  std::vector<Eigen::RowVector3d> vertices_;
+  std::vector<std::array<int, 3>> faces_;
+};
+
+}  // namespace
+
+TriangleMesh read_obj(const std::filesystem::path& path) {
+  const std::string name = path.string();
+  std::error_code ec;
+  const auto status = std::filesystem::status(path, ec);
+  if (!std::filesystem::exists(status)) {
+    throw MeshError(name + ": cannot read the OBJ file: no such file");
+  }
+  if (std::filesystem::is_directory(status)) {
+    throw MeshError(name + ": cannot read the OBJ file: it is a directory");
+  }
+  if (!std::filesystem::is_regular_file(status)) {
+    // A device or a pipe (/dev/zero, a FIFO) may never end: reading it could hang.
+    throw MeshError(name + ": cannot read the OBJ file: not a regular file");
+  }
+  std::ifstream in(path, std::ios::binary);
+  if (!in) {
+    throw MeshError(name + ": cannot open the OBJ file for reading");
+  }
+  const std::string text{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+  if (in.bad()) {
+    throw MeshError(name + ": cannot read the OBJ file: read error");
+  }
+  return ObjParser(name).parse(text);
+}
+
+void write_obj(const TriangleMesh& mesh, const std::filesystem::path& path,
+               std::string_view comment) {
+  const std::string name = path.string();
+  // Refuse what read_obj() would refuse, so that every file written here reads back.
+  if (mesh.F.rows() == 0) {
+    throw MeshError(name + ": cannot write an OBJ file without faces");
+  }
+  if (!mesh.V.allFinite()) {
+    throw MeshError(name + ": cannot write non-finite vertex coordinates to an OBJ file");
+  }
+  if (mesh.F.minCoeff() < 0 || mesh.F.maxCoeff() >= mesh.V.rows()) {
+    throw MeshError(name + ": cannot write an OBJ file with face indices outside [0, " +
+                    std::to_string(mesh.V.rows()) + ")");
+  }
+  std::string text;
+  if (!comment.empty()) {
+    for (std::size_t start = 0;;) {
+      const std::size_t end = comment.find('\n', start);
+      text.append("# ").append(comment.substr(start, end - start)).append("\n");
+      if (end == std::string_view::npos) break;
+      start = end + 1;
+    }
+  }
+  // std::to_chars is independent of the C locale, and 17 significant digits identify every
+  // double: read_obj() gives back exactly these numbers.
+  char buffer[32];
+  auto append_number = [&](double x) {
+    const auto result =
+        std::to_chars(buffer, buffer + sizeof buffer, x, std::chars_format::general, 17);
+    text += ' ';
+    text.append(buffer, result.ptr);
+  };
+  for (Eigen::Index i = 0; i < mesh.V.rows(); ++i) {
+    text += 'v';
+    for (int k = 0; k < 3; ++k) append_number(mesh.V(i, k));
+    text += '\n';
+  }
+  for (Eigen::Index f = 0; f < mesh.F.rows(); ++f) {
+    text += 'f';
+    for (int k = 0; k < 3; ++k) text += ' ' + std::to_string(mesh.F(f, k) + 1);
+    text += '\n';
+  }
+  std::ofstream out(path, std::ios::binary | std::ios::trunc);
+  if (!out) {
+    throw MeshError(name + ": cannot open the OBJ file for writing");
+  }
+  out.write(text.data(), static_cast<std::streamsize>(text.size()));
+  out.close();
+  if (!out) {
+    throw MeshError(name + ": cannot write the OBJ file: write error");
+  }
+}
+
+}  // namespace grbd::body

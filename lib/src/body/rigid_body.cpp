@@ -1,0 +1,103 @@
+/// \file
+/// \brief The rigid body in its principal frame: the body of a mesh, mass matrix, kinetic energy,
+/// angular momentum, generalized forces and the accelerations of the Newton–Euler equations (the
+/// non-exercise part of chapter 2's rigid body; point_jacobian and newton_euler_h are exercises).
+
+#include "grbd/body/rigid_body.hpp"
+
+#include <Eigen/Geometry>  // cross()
+#include <cmath>
+#include <cstdio>
+#include <string>
+
+#include "grbd/core/error.hpp"
+#include "grbd/kinematics/rigid_motion.hpp"
+#include "grbd/kinematics/rotation.hpp"
+
+namespace grbd::body {
+
+namespace {
+
+/// A double with all 17 significant digits, for error messages.
+std::string format(double x) {
+  char buffer[32];
+  std::snprintf(buffer, sizeof buffer, "%.17g", x);
+  return buffer;
+}
+
+/// Throws InvalidArgument unless m and the three principal moments are positive and finite: M
+/// must be symmetric positive definite for u̇ = M⁻¹h and T = ½ uᵀMu to make sense.
+void require_valid(const RigidBody& body, std::string_view where) {
+  if (!(body.m > 0.0) || !std::isfinite(body.m)) {
+    throw InvalidArgument(std::string(where) +
+                          ": the mass m must be positive and finite, but m = " + format(body.m));
+  }
+  for (int i = 0; i < 3; ++i) {
+    if (!(body.K_Theta[i] > 0.0) || !std::isfinite(body.K_Theta[i])) {
+      throw InvalidArgument(std::string(where) + ": the principal moment K_Theta[" +
+                            std::to_string(i) + "] must be positive and finite, but it is " +
+                            format(body.K_Theta[i]));
+    }
+  }
+}
+
+}  // namespace
+
+//! [rigid body from mesh]
+BodyFromMesh rigid_body_from_mesh(const TriangleMesh& mesh, double density,
+                                  std::string_view source) {
+  // mass_properties() checks the mesh (closed, outward) and the density; Θ_S = A_MK diag(Θ) A_MKᵀ
+  // then makes K the principal frame, with origin S: K_x = A_MKᵀ (M_x − M_r_S).
+  const MassProperties properties = mass_properties(mesh, density, source);
+  const PrincipalAxes axes = principal_axes(properties.M_Theta_S);
+  BodyFromMesh result{RigidBody{properties.mass, axes.K_Theta}, properties.M_r_S, axes.A_MK};
+  // A degenerate solid (a needle, a sliver) can leave a principal moment at zero up to round-off.
+  require_valid(result.body, source);
+  return result;
+}
+//! [rigid body from mesh]
+
+Matrix6 mass_matrix(const RigidBody& body) {
+  require_valid(body, "mass_matrix");
+  Vector6 diagonal;
+  diagonal << Vector3::Constant(body.m), body.K_Theta;
+  return Matrix6(diagonal.asDiagonal());
+}
+
+double kinetic_energy(const RigidBody& body, const Vector6& u) {
+  // ½ uᵀ M u with M diagonal, without forming M.
+  const Vector3 K_omega = kinematics::angular_velocity(u);
+  return 0.5 * body.m * kinematics::linear_velocity(u).squaredNorm() +
+         0.5 * K_omega.dot(body.K_Theta.cwiseProduct(K_omega));
+}
+
+Vector3 I_angular_momentum(const RigidBody& body, const State& x) {
+  // K_L = Θ K_omega in the body frame, taken to frame I by A_IK = R(p).
+  return kinematics::rotation_matrix(kinematics::orientation(x.q)) *
+         body.K_Theta.cwiseProduct(kinematics::angular_velocity(x.u));
+}
+
+//! [generalized force]
+Vector6 generalized_force(const Vector7& q, const Vector3& K_rho, const Vector3& I_F) {
+  // J_Pᵀ I_F = (I_F, −(A_IK K_ρ̃)ᵀ I_F) = (I_F, K_ρ̃ A_IKᵀ I_F): the force acts on S unchanged and
+  // adds the moment K_rho × K_F about S, with the force taken to frame K. Written out rather than
+  // through point_jacobian(): no 3 × 6 product for what is one rotation and one cross product.
+  const Vector3 K_F = kinematics::rotation_matrix(kinematics::orientation(q)).transpose() * I_F;
+  Vector6 f;
+  f << I_F, K_rho.cross(K_F);
+  return f;
+}
+//! [generalized force]
+
+//! [newton euler u dot]
+Vector6 newton_euler_u_dot(const RigidBody& body, const Vector6& u, const Loads& loads) {
+  require_valid(body, "newton_euler_u_dot");
+  // M is diagonal in the principal frame: M⁻¹ h is a division per coordinate, no solve.
+  const Vector6 h = newton_euler_h(body, u, loads);
+  Vector6 u_dot;
+  u_dot << h.head<3>() / body.m, h.tail<3>().cwiseQuotient(body.K_Theta);
+  return u_dot;
+}
+//! [newton euler u dot]
+
+}  // namespace grbd::body
