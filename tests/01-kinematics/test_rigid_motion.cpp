@@ -5,9 +5,9 @@
 // Independent references: the exact motion with constant u,
 //   q(t) = (r0 + t v, p0 ⊗ exp(t ω / 2)),
 // with the product through 2 × 2 complex matrices and exp in closed form (cos, sin n), both
-// written in this file; central differences of it; the inertial-frame formula
-// v_P = v_S + I_ω × I_r_SP with the classical axis–angle matrix; the closed-form growth
-// factor of explicit Euler; and Eigen's matrix exponential (MatrixFunctions).
+// written out in grbd_test/references.hpp (exact_motion()); central differences of it; the
+// inertial-frame formula v_P = v_S + I_ω × I_r_SP with the classical axis–angle matrix; the
+// closed-form growth factor of explicit Euler; and Eigen's matrix exponential (MatrixFunctions).
 
 #include <gtest/gtest.h>
 
@@ -21,6 +21,7 @@
 #include "grbd/kinematics/rigid_motion.hpp"
 #include "grbd/kinematics/rotation.hpp"
 #include "grbd/kinematics/skew.hpp"
+#include "grbd_test/bodies.hpp"
 #include "grbd_test/random.hpp"
 #include "grbd_test/references.hpp"
 
@@ -43,24 +44,6 @@ using grbd::kinematics::skew;
 constexpr double pi = std::numbers::pi;
 constexpr double kEps = std::numeric_limits<double>::epsilon();
 
-/// The exact motion for constant u = (v, ω), from q0 at t = 0.
-Vector7 exact_motion(const Vector7& q0, const Vector6& u, double t) {
-  const Vector3 r = q0.head<3>() + t * u.head<3>();
-  const Quaternion p = reference_product(orientation(q0), closed_form_exp(0.5 * t * u.tail<3>()));
-  return make_q(r, p);
-}
-
-struct Sample {
-  Vector7 q;
-  Vector6 u;
-};
-
-/// A random body: r0, v, ω ∈ [−1, 1)³ or [−2, 2)³, unit p.
-Sample random_body(grbd::test::Random& rng) {
-  return {make_q(rng.vector3(), rng.unit_quaternion()),
-          make_u(rng.vector3(-2, 2), rng.vector3(-2, 2))};
-}
-
 // Central differences with step h = 1e-5 along the exact motion. Truncation error h²/6 |q⃛|;
 // with |ω| ≤ 2√3 and |ρ| ≤ √3, |q⃛| ≤ |ω|³/8 for p and ≤ |ω|³|ρ| ≈ 72 for a point, so at most
 // ~1.2e-9. Round-off: ~2 ulps of |q| ≤ 3 divided by 2h, ~1e-10. Tolerance 1e-8 leaves a
@@ -79,7 +62,7 @@ TEST(Exercise1_8, MatchesCentralDifferencesOfTheExactMotion) {
   grbd::test::Random rng(3801);
   double worst = 0.0;
   for (int n = 0; n < 2000; ++n) {
-    const auto [q, u] = random_body(rng);
+    const auto [q, u] = random_state(rng);
     const Vector7 difference = (exact_motion(q, u, kH) - exact_motion(q, u, -kH)) / (2.0 * kH);
     worst = std::max(worst,
                      (grbd::kinematics::kinematic_map(q) * u - difference).cwiseAbs().maxCoeff());
@@ -130,7 +113,7 @@ TEST(Exercise1_9, MatchesCentralDifferencesOfPointPosition) {
   grbd::test::Random rng(3901);
   double worst = 0.0;
   for (int n = 0; n < 2000; ++n) {
-    const auto [q, u] = random_body(rng);
+    const auto [q, u] = random_state(rng);
     const Vector3 rho = rng.vector3();
     const Vector3 difference = (point_position(exact_motion(q, u, kH), rho) -
                                 point_position(exact_motion(q, u, -kH), rho)) /
@@ -148,8 +131,7 @@ TEST(Exercise1_9, EqualsTheSpatialVelocityFormula) {
   double worst = 0.0;
   for (int n = 0; n < 10000; ++n) {
     const Vector3 theta = rng.uniform(0.0, pi) * rng.unit_vector3();
-    const Quaternion p{std::cos(0.5 * theta.norm()),
-                       Vector3(std::sin(0.5 * theta.norm()) * theta.normalized())};
+    const Quaternion p = closed_form_exp(theta.normalized(), 0.5 * theta.norm());
     const Vector3 v = rng.vector3();
     const Vector3 omega = rng.vector3(-2, 2);
     const Vector3 rho = rng.vector3();
@@ -171,7 +153,7 @@ TEST(Exercise1_9, VelocityFieldIsRigid) {
   grbd::test::Random rng(3903);
   double worst = 0.0;
   for (int n = 0; n < 10000; ++n) {
-    const auto [q, u] = random_body(rng);
+    const auto [q, u] = random_state(rng);
     const Vector3 a = rng.vector3();
     const Vector3 b = rng.vector3();
     const double relative = (point_velocity(q, u, a) - point_velocity(q, u, b))
@@ -209,7 +191,7 @@ TEST(QDot, IsTheKinematicMapTimesU) {
   grbd::test::Random rng(4002);
   double worst = 0.0;
   for (int n = 0; n < 1000; ++n) {
-    const auto [q, u] = random_body(rng);
+    const auto [q, u] = random_state(rng);
     const Vector7 qdot = grbd::kinematics::q_dot(q, u);
     const Quaternion pdot = 0.5 * reference_product(orientation(q), Quaternion::pure(u.tail<3>()));
     worst = std::max(worst, (qdot.tail<4>() - pdot.coeffs()).cwiseAbs().maxCoeff());
@@ -224,8 +206,7 @@ TEST(PointPosition, IsCentreOfMassPlusRotatedOffset) {
   double worst = 0.0;
   for (int n = 0; n < 10000; ++n) {
     const Vector3 theta = rng.uniform(0.0, pi) * rng.unit_vector3();
-    const Quaternion p{std::cos(0.5 * theta.norm()),
-                       Vector3(std::sin(0.5 * theta.norm()) * theta.normalized())};
+    const Quaternion p = closed_form_exp(theta.normalized(), 0.5 * theta.norm());
     const Vector3 r = rng.vector3();
     const Vector3 rho = rng.vector3();
     const Vector3 expected = r + axis_angle_matrix(theta) * rho;
@@ -248,7 +229,7 @@ TEST(ExplicitEulerDrift, NormSquaredGrowsByTheExactFactorEveryStep) {
   constexpr int N = 1000;
   for (double h : {1e-3, 1e-2, 1e-1}) {
     for (int c = 0; c < 5; ++c) {
-      auto [q, u] = random_body(rng);
+      auto [q, u] = random_state(rng);
       const Vector3 r0 = q.head<3>();
       const double factor = 1.0 + 0.25 * h * h * u.tail<3>().squaredNorm();
       const double n0 = q.tail<4>().squaredNorm();
@@ -279,7 +260,7 @@ TEST(ExpMapStep, IsExactForConstantAngularVelocity) {
   constexpr int N = 1000;
   for (double h : {1e-3, 1e-2, 1e-1}) {
     for (int c = 0; c < 5; ++c) {
-      auto [q, u] = random_body(rng);
+      auto [q, u] = random_state(rng);
       const Vector7 q0 = q;
       for (int n = 0; n < N; ++n) q = grbd::kinematics::exp_map_step(q, u, h);
       const Matrix3 rotation = N * h * skew(u.tail<3>());
@@ -298,7 +279,7 @@ TEST(ExpMapStep, OneStepIsTheExactMotion) {
   grbd::test::Random rng(4202);
   double worst = 0.0;
   for (int n = 0; n < 10000; ++n) {
-    const auto [q, u] = random_body(rng);
+    const auto [q, u] = random_state(rng);
     const double h = rng.uniform(0.0, 1.0);
     worst = std::max(
         worst,

@@ -40,9 +40,10 @@ constexpr int kSamples = 10000;
 constexpr double kTol = 1e-14;
 constexpr double pi = std::numbers::pi;
 
-/// The unit quaternion of the rotation by `angle` about the unit vector n, written out.
+/// The unit quaternion of the rotation by `angle` about the unit vector n, (cos(angle/2),
+/// sin(angle/2) n): the closed-form exp of references.hpp at angle/2.
 Quaternion axis_angle_quaternion(const Vector3& n, double angle) {
-  return {std::cos(0.5 * angle), Vector3(std::sin(0.5 * angle) * n)};
+  return closed_form_exp(n, 0.5 * angle);
 }
 
 }  // namespace

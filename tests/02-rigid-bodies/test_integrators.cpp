@@ -6,11 +6,11 @@
 // Independent references: the closed-form motion of the torque-free symmetric top (REFERENCES.md)
 //   A(t) = exp(t I_L/I⊥) A₀ exp(t ν e₃),  ω(t) = exp(−t ν e₃) A₀ᵀ I_L/I⊥ + ν e₃,
 //   ν = ω₃ (1 − I₃/I⊥),
-// with the axis–angle matrices of grbd_test/references.hpp; the exact one-step identities of
-// explicit Euler on Euler's equations (ΔE = h²/2 ω̇ᵀΘω̇, Δ|L|² = h²|L × ω|²); the discrete free fall
-// of each scheme in closed form; the exact invariant of symplectic Euler on a harmonic
-// oscillator; Euler's equations written out by hand; rotation matrices of Eigen::Quaterniond;
-// and conservation laws (I_L, |L|) of the torque-free body.
+// written out in grbd_test/bodies.hpp (SymmetricTop); the exact one-step identities of explicit
+// Euler on Euler's equations (ΔE = h²/2 ω̇ᵀΘω̇, Δ|L|² = h²|L × ω|²); the discrete free fall of each
+// scheme in closed form; the exact invariant of symplectic Euler on a harmonic oscillator;
+// Euler's equations written out by hand (grbd_test/bodies.hpp); rotation matrices of
+// Eigen::Quaterniond; and conservation laws (I_L, |L|) of the torque-free body.
 
 #include <gtest/gtest.h>
 
@@ -25,6 +25,7 @@
 #include "grbd/body/rigid_body.hpp"
 #include "grbd/core/error.hpp"
 #include "grbd/kinematics/rigid_motion.hpp"
+#include "grbd_test/bodies.hpp"
 #include "grbd_test/random.hpp"
 #include "grbd_test/references.hpp"
 
@@ -43,23 +44,18 @@ using grbd::kinematics::make_q;
 using grbd::kinematics::make_u;
 using grbd::kinematics::Quaternion;
 using grbd::test::axis_angle_matrix;
+using grbd::test::exact_motion;
 using grbd::test::max_abs;
+using grbd::test::random_body;
+using grbd::test::random_loads;
+using grbd::test::random_state;
+using grbd::test::reference_A_IK;
+using grbd::test::SymmetricTop;
 
 constexpr double kEps = std::numeric_limits<double>::epsilon();
 
 /// One step of a scheme, as every step function of integrators.hpp.
 using StepFunction = State (*)(const RigidBody&, const State&, const Loads&, double);
-
-/// The rotation matrix of the unit quaternion in q, by Eigen: no code of chapter 1.
-Matrix3 reference_A_IK(const Vector7& q) {
-  return Eigen::Quaterniond(q[3], q[4], q[5], q[6]).toRotationMatrix();
-}
-
-/// The quaternion (scalar first) of a rotation matrix, by Eigen.
-Quaternion reference_quaternion(const Matrix3& A) {
-  const Eigen::Quaterniond e(A);
-  return {e.w(), e.x(), e.y(), e.z()};
-}
 
 Vector3 K_L(const RigidBody& body, const State& x) {
   return body.K_Theta.cwiseProduct(x.u.tail<3>());
@@ -67,51 +63,29 @@ Vector3 K_L(const RigidBody& body, const State& x) {
 
 /// ω̇ of the torque-free Euler equations written out: Θ_i ω̇_i = (Θ_j − Θ_k) ω_j ω_k.
 Vector3 torque_free_omega_dot(const RigidBody& body, const Vector3& w) {
-  const Vector3& T = body.K_Theta;
-  return {(T[1] - T[2]) * w[1] * w[2] / T[0], (T[2] - T[0]) * w[2] * w[0] / T[1],
-          (T[0] - T[1]) * w[0] * w[1] / T[2]};
+  return grbd::test::gyroscopic_torque(body, w).cwiseQuotient(body.K_Theta);
 }
 
-/// A random body (moments in [0.1, 3), mass in [0.5, 3)) and state (r ∈ [−1, 1)³, unit p,
-/// v and ω ∈ [−2, 2)³).
-RigidBody random_body(grbd::test::Random& rng) {
-  return {rng.uniform(0.5, 3.0),
-          Vector3(rng.uniform(0.1, 3.0), rng.uniform(0.1, 3.0), rng.uniform(0.1, 3.0))};
-}
-State random_state(grbd::test::Random& rng) {
-  return {make_q(rng.vector3(), rng.unit_quaternion()),
-          make_u(rng.vector3(-2, 2), rng.vector3(-2, 2))};
+/// The symmetric top of this file (grbd_test/bodies.hpp: its closed-form motion), tumbling with
+/// I⊥ = 1 and I₃ = 0.4.
+SymmetricTop tumbling_top() {
+  return {RigidBody{2.0, Vector3(1.0, 1.0, 0.4)}, Vector3(0.6, -0.3, 2.0),
+          axis_angle_matrix(0.7 * Vector3(1.0, 2.0, 3.0).normalized())};
 }
 
-/// The torque-free symmetric top I₁ = I₂ = I⊥ and its closed-form motion.
-struct SymmetricTop {
-  RigidBody body{2.0, Vector3(1.0, 1.0, 0.4)};
-  double I_perp = 1.0;
-  Vector3 omega0{0.6, -0.3, 2.0};
-  Matrix3 A0 = axis_angle_matrix(0.7 * Vector3(1.0, 2.0, 3.0).normalized());
-  Vector3 I_L = A0 * body.K_Theta.cwiseProduct(omega0);
-  double nu = omega0.z() * (1.0 - body.K_Theta.z() / I_perp);
-
-  State initial() const {
-    return {make_q(Vector3(0.5, -1.0, 2.0), reference_quaternion(A0)),
-            make_u(Vector3(0.3, 0.2, -0.1), omega0)};
-  }
-  Matrix3 A(double t) const {
-    return axis_angle_matrix(t * I_L / I_perp) * A0 * axis_angle_matrix(t * nu * Vector3::UnitZ());
-  }
-  Vector3 omega(double t) const {
-    return axis_angle_matrix(-t * nu * Vector3::UnitZ()) * A0.transpose() * I_L / I_perp +
-           nu * Vector3::UnitZ();
-  }
-};
+/// The top's initial state, with S at (0.5, −1, 2) moving at (0.3, 0.2, −0.1).
+State initial_state(const SymmetricTop& top) {
+  return {make_q(Vector3(0.5, -1.0, 2.0), grbd::test::reference_quaternion(top.A0)),
+          make_u(Vector3(0.3, 0.2, -0.1), top.omega0)};
+}
 
 /// Errors of a scheme against the closed-form top at T = 3 after N steps: the orientation
 /// ‖A − A_exact‖_F and the angular velocity |ω − ω_exact|.
 std::pair<double, double> top_errors(StepFunction step, int N) {
-  const SymmetricTop top;
+  const SymmetricTop top = tumbling_top();
   constexpr double T = 3.0;
   const double h = T / N;
-  State x = top.initial();
+  State x = initial_state(top);
   for (int n = 0; n < N; ++n) x = step(top.body, x, Loads{}, h);
   return {(reference_A_IK(x.q) - top.A(T)).norm(), (x.u.tail<3>() - top.omega(T)).norm()};
 }
@@ -165,6 +139,20 @@ void expect_discrete_free_fall(StepFunction step, double c) {
   EXPECT_LE(worst_p, 2.0 * kEps) << "a body with ω = 0 does not turn";
 }
 
+/// The isotropic harmonic oscillator F = −k r on a body that does not turn: m = 2, k = 50
+/// (w² = k/m = 25), h = 0.01, from r = (0.3, −0.2, 0.1) with v = (1, 0.5, −0.5).
+struct Oscillator {
+  RigidBody body{2.0, Vector3::Ones()};
+  double k = 50.0;
+  double w2 = k / body.m;
+  double h = 0.01;
+  State initial{make_q(Vector3(0.3, -0.2, 0.1), Quaternion()),
+                make_u(Vector3(1.0, 0.5, -0.5), Vector3::Zero())};
+
+  /// The spring force −k r at the state s.
+  Loads spring(const State& s) const { return {-k * s.q.head<3>(), Vector3::Zero()}; }
+};
+
 /// One step of a scheme on a torque-free, force-free body: the exact one-step identities of
 /// explicit Euler on Euler's equations, ΔE = h²/2 ω̇ᵀΘω̇ and Δ|L|² = h²|L × ω|², for the schemes
 /// whose velocity update is explicit Euler. E ≤ 36 and |L|² ≤ 108 for the random inputs; the
@@ -216,7 +204,7 @@ TEST(Exercise2_5, EnergyChangeWithLoadsIsTheExactExplicitEulerAmount) {
     for (int n = 0; n < 2000; ++n) {
       const RigidBody body = random_body(rng);
       const State x = random_state(rng);
-      const Loads loads{rng.vector3(), rng.vector3()};
+      const Loads loads = random_loads(rng);
       const State y = grbd::body::explicit_exp_map_step(body, x, loads, h);
       const Vector3 v = x.u.head<3>();
       const Vector3 w = x.u.tail<3>();
@@ -243,14 +231,10 @@ TEST(Exercise2_5, PositionAndOrientationMoveWithTheOldVelocities) {
   for (int n = 0; n < 10000; ++n) {
     const RigidBody body = random_body(rng);
     const State x = random_state(rng);
-    const Loads loads{rng.vector3(), rng.vector3()};
+    const Loads loads = random_loads(rng);
     const double h = rng.uniform(0.0, 0.1);
     const State y = grbd::body::explicit_exp_map_step(body, x, loads, h);
-    const Quaternion p(Vector4(x.q.tail<4>()));
-    const Quaternion p_plus = grbd::test::reference_product(
-        p, grbd::test::closed_form_exp(0.5 * h * Vector3(x.u.tail<3>())));
-    worst = std::max(worst, max_abs(y.q.head<3>() - (x.q.head<3>() + h * x.u.head<3>())));
-    worst = std::max(worst, max_abs(y.q.tail<4>() - p_plus.coeffs()));
+    worst = std::max(worst, max_abs(y.q - exact_motion(x.q, x.u, h)));
   }
   EXPECT_LE(worst, 1e-15);
 }
@@ -260,8 +244,8 @@ TEST(Exercise2_5, PositionAndOrientationMoveWithTheOldVelocities) {
 // independent) |p| − 1 after 10⁶ steps is a random walk of ~√N eps ≈ 2e-13: tolerance 1e-12.
 // For comparison, explicit Euler on the same motion multiplies |p|² by (1 + h²|ω|²/4) per step.
 TEST(Exercise2_5, UnitQuaternionAfterAMillionStepsOfATumblingTop) {
-  const SymmetricTop top;
-  State x = top.initial();
+  const SymmetricTop top = tumbling_top();
+  State x = initial_state(top);
   x.q.tail<4>() = Vector4(x.q.tail<4>()).normalized();
   const double h = 1e-3;
   for (int n = 0; n < 1000000; ++n) {
@@ -306,19 +290,16 @@ TEST(Exercise2_5, FreeFallIsTheExplicitEulerParabola) {
 // |v|² + w²|r|² (w² = k/m) by exactly 1 + h²w² per step: the scheme pumps energy into any
 // oscillation. 200 steps; each step's ratio to 1e-14 relative.
 TEST(Exercise2_5, HarmonicOscillatorGainsTheExactFactorEachStep) {
-  const RigidBody body{2.0, Vector3::Ones()};
-  const double k = 50.0;
-  const double w2 = k / body.m;
-  const double h = 0.01;
-  State x{make_q(Vector3(0.3, -0.2, 0.1), Quaternion()),
-          make_u(Vector3(1.0, 0.5, -0.5), Vector3::Zero())};
+  const Oscillator oscillator;
+  const double w2 = oscillator.w2;
+  const double h = oscillator.h;
+  State x = oscillator.initial;
   const auto energy = [&](const State& s) {
     return s.u.head<3>().squaredNorm() + w2 * s.q.head<3>().squaredNorm();
   };
   double worst = 0.0;
   for (int n = 0; n < 200; ++n) {
-    const Loads spring{-k * x.q.head<3>(), Vector3::Zero()};
-    const State y = grbd::body::explicit_exp_map_step(body, x, spring, h);
+    const State y = grbd::body::explicit_exp_map_step(oscillator.body, x, oscillator.spring(x), h);
     worst = std::max(worst, std::abs(energy(y) / energy(x) / (1.0 + h * h * w2) - 1.0));
     x = y;
   }
@@ -492,7 +473,7 @@ TEST(StepDispatch, CallsTheChosenScheme) {
     for (int n = 0; n < 100; ++n) {
       const RigidBody body = random_body(rng);
       const State x = random_state(rng);
-      const Loads loads{rng.vector3(), rng.vector3()};
+      const Loads loads = random_loads(rng);
       const State by_step = grbd::body::step(body, x, loads, 0.01, scheme);
       const State direct = function(body, x, loads, 0.01);
       ASSERT_EQ(by_step.q, direct.q) << grbd::body::integrator_name(scheme);
@@ -572,17 +553,14 @@ TEST(SymplecticExpMap, VelocitiesFirstThenTheExactMotionWithThem) {
   for (int n = 0; n < 10000; ++n) {
     const RigidBody body = random_body(rng);
     const State x = random_state(rng);
-    const Loads loads{rng.vector3(), rng.vector3()};
+    const Loads loads = random_loads(rng);
     const double h = rng.uniform(0.0, 0.1);
     const State y = grbd::body::symplectic_exp_map_step(body, x, loads, h);
     const Vector3 v = x.u.head<3>() + h * loads.I_F / body.m;
     const Vector3 w = x.u.tail<3>() + h * (torque_free_omega_dot(body, x.u.tail<3>()) +
                                            loads.K_M.cwiseQuotient(body.K_Theta));
-    const Quaternion p = grbd::test::reference_product(Quaternion(Vector4(x.q.tail<4>())),
-                                                       grbd::test::closed_form_exp(0.5 * h * w));
     worst = std::max({worst, max_abs(y.u.head<3>() - v), max_abs(y.u.tail<3>() - w),
-                      max_abs(y.q.head<3>() - (x.q.head<3>() + h * v)),
-                      max_abs(y.q.tail<4>() - p.coeffs())});
+                      max_abs(y.q - exact_motion(x.q, make_u(v, w), h))});
   }
   EXPECT_LE(worst, 1e-14);
 }
@@ -600,12 +578,10 @@ TEST(SymplecticExpMap, FreeRotationGainsEnergyExactlyAsExplicitEuler) {
 // so the energy stays within O(h) of its start forever. 10⁴ steps; Q ≈ 2.5, each step rounds a
 // few ulps: tolerance 1e-12 relative (random walk, observed ~1e-14).
 TEST(SymplecticExpMap, HarmonicOscillatorKeepsTheModifiedEnergy) {
-  const RigidBody body{2.0, Vector3::Ones()};
-  const double k = 50.0;
-  const double w2 = k / body.m;
-  const double h = 0.01;
-  State x{make_q(Vector3(0.3, -0.2, 0.1), Quaternion()),
-          make_u(Vector3(1.0, 0.5, -0.5), Vector3::Zero())};
+  const Oscillator oscillator;
+  const double w2 = oscillator.w2;
+  const double h = oscillator.h;
+  State x = oscillator.initial;
   const auto Q = [&](const State& s) {
     const Vector3 r = s.q.head<3>();
     const Vector3 v = s.u.head<3>();
@@ -614,8 +590,7 @@ TEST(SymplecticExpMap, HarmonicOscillatorKeepsTheModifiedEnergy) {
   const double Q0 = Q(x);
   double worst = 0.0;
   for (int n = 0; n < 10000; ++n) {
-    const Loads spring{-k * x.q.head<3>(), Vector3::Zero()};
-    x = grbd::body::symplectic_exp_map_step(body, x, spring, h);
+    x = grbd::body::symplectic_exp_map_step(oscillator.body, x, oscillator.spring(x), h);
     worst = std::max(worst, std::abs(Q(x) / Q0 - 1.0));
   }
   EXPECT_LE(worst, 1e-12);
@@ -758,7 +733,7 @@ TEST(LiePoisson, IsTimeReversible) {
   for (int n = 0; n < 10000; ++n) {
     const RigidBody body = random_body(rng);
     const State x = random_state(rng);
-    const Loads loads{rng.vector3(), rng.vector3()};
+    const Loads loads = random_loads(rng);
     const double h = rng.uniform(0.0, 0.2);
     State y = grbd::body::lie_poisson_step(body, x, loads, h);
     y.u = -y.u;
@@ -775,11 +750,11 @@ TEST(LiePoisson, IsTimeReversible) {
 // step) divided by T must match |L|/I⊥ to 1e-6 relative, and the cone angle hold to 1e-6
 // (second-order error ~ C h², observed ≲ 1e-7).
 TEST(LiePoisson, SymmetryAxisOfATopPrecessesAboutLAtLOverIPerp) {
-  const SymmetricTop top;
+  const SymmetricTop top = tumbling_top();
   const double L = top.I_L.norm();
   const Vector3 L_hat = top.I_L / L;
   const double cos_cone = top.body.K_Theta.z() * top.omega0.z() / L;
-  State x = top.initial();
+  State x = initial_state(top);
   const auto transverse = [&](const State& s) {
     const Vector3 a = reference_A_IK(s.q).col(2);
     return std::pair<Vector3, double>{a - a.dot(L_hat) * L_hat, a.dot(L_hat)};
@@ -818,7 +793,7 @@ TEST(ImplicitGyroscopic, IsOneNewtonStepOnTheImplicitEulerEquations) {
   for (int n = 0; n < 10000; ++n) {
     const RigidBody body = random_body(rng);
     const State x = random_state(rng);
-    const Loads loads{rng.vector3(), rng.vector3()};
+    const Loads loads = random_loads(rng);
     const double h = rng.uniform(0.0, 0.2);
     const State y = grbd::body::implicit_gyroscopic_step(body, x, loads, h);
     const Vector3 w = x.u.tail<3>();
@@ -830,12 +805,8 @@ TEST(ImplicitGyroscopic, IsOneNewtonStepOnTheImplicitEulerEquations) {
     const double scale = body.K_Theta.maxCoeff() * (w.norm() + y.u.tail<3>().norm()) + f.norm();
     worst_newton = std::max(worst_newton, (J_delta + f).norm() / scale);
     const Vector3 v = x.u.head<3>() + h * loads.I_F / body.m;
-    const Quaternion p = grbd::test::reference_product(
-        Quaternion(Vector4(x.q.tail<4>())),
-        grbd::test::closed_form_exp(0.5 * h * Vector3(y.u.tail<3>())));
     worst_q = std::max({worst_q, max_abs(y.u.head<3>() - v),
-                        max_abs(y.q.head<3>() - (x.q.head<3>() + h * v)),
-                        max_abs(y.q.tail<4>() - p.coeffs())});
+                        max_abs(y.q - exact_motion(x.q, make_u(v, y.u.tail<3>()), h))});
   }
   EXPECT_LE(worst_newton, 1e-14);
   EXPECT_LE(worst_q, 1e-14);

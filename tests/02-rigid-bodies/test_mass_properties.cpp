@@ -1,7 +1,7 @@
 // Chapter 2: mass properties of closed triangle meshes (Exercises 2.1 and 2.2, and the core
 // functions of mass_properties.hpp).
 //
-// Independent references, all written out in this file:
+// Independent references, written out in this file (the box table in grbd_test/bodies.hpp):
 // - the affine image of the unit corner tetrahedron T0 = {ξ ≥ 0, Σξ ≤ 1}, whose moments are
 //   Dirichlet integrals, ∫_T0 ξ^a η^b ζ^c = a! b! c! / (a + b + c + 3)!: |T0| = 1/6,
 //   ∫ ξ = 1/24, ∫ ξ² = 1/60, ∫ ξη = 1/120, so ∫ ξξᵀ = (I + 11ᵀ)/120;
@@ -33,8 +33,9 @@
 #include "grbd/body/mass_properties.hpp"
 #include "grbd/body/triangle_mesh.hpp"
 #include "grbd/core/error.hpp"
-#include "grbd/kinematics/rotation.hpp"
+#include "grbd_test/bodies.hpp"
 #include "grbd_test/random.hpp"
+#include "grbd_test/references.hpp"
 
 namespace {
 
@@ -48,18 +49,14 @@ using grbd::body::PrincipalAxes;
 using grbd::body::tetrahedron_integrals;
 using grbd::body::TriangleMesh;
 using grbd::body::VolumeIntegrals;
+using grbd::test::box_inertia;
+using grbd::test::max_abs;
 
 constexpr double pi = std::numbers::pi;
-
-double max_abs(const Matrix3& A) { return A.cwiseAbs().maxCoeff(); }
 
 /// Relative distance of two tensors, measured by the larger entry of the expected one.
 double relative(const Matrix3& found, const Matrix3& expected) {
   return max_abs(found - expected) / max_abs(expected);
-}
-
-Matrix3 random_rotation(grbd::test::Random& rng) {
-  return grbd::kinematics::rotation_matrix(rng.unit_quaternion());
 }
 
 /// The parallel-axis term m (dᵀd I − d dᵀ) for a shift d.
@@ -103,10 +100,18 @@ VolumeIntegrals box_integrals(const Vector3& lo, const Vector3& hi) {
   return I;
 }
 
-/// Box table: Θ_S = m/3 diag(b² + c², a² + c², a² + b²) for half extents (a, b, c).
-Matrix3 box_inertia(const Vector3& h, double mass) {
-  const Vector3 s = h.cwiseAbs2();
-  return (mass / 3.0 * Vector3(s.y() + s.z(), s.x() + s.z(), s.x() + s.y())).asDiagonal();
+/// Cylinder table: Θ_S = diag(m(3R² + h²)/12, m(3R² + h²)/12, mR²/2) about the axis z.
+Matrix3 cylinder_inertia(double mass, double R, double h) {
+  return Vector3(mass * (3 * R * R + h * h) / 12.0, mass * (3 * R * R + h * h) / 12.0,
+                 0.5 * mass * R * R)
+      .asDiagonal();
+}
+
+/// The unit corner tetrahedron's Θ_S for ρ = 1 (Tonon 2004): diagonal 1/80, off-diagonal 1/480.
+Matrix3 corner_tetrahedron_inertia() {
+  Matrix3 Theta = Matrix3::Constant(1.0 / 480.0);
+  Theta.diagonal().setConstant(1.0 / 80.0);
+  return Theta;
 }
 
 /// Tonon (2004), the formulas for a, b, c, a', b', c': the inertia tensor about the centroid of
@@ -297,8 +302,7 @@ TEST(Exercise2_2, UnitCornerTetrahedronHasTononsInertia) {
   I.volume = 1.0 / 6.0;
   I.first = Vector3::Constant(1.0 / 24.0);
   I.second = (Matrix3::Identity() + Matrix3::Ones()) / 120.0;
-  Matrix3 expected = Matrix3::Constant(1.0 / 480.0);
-  expected.diagonal().setConstant(1.0 / 80.0);
+  const Matrix3 expected = corner_tetrahedron_inertia();
   EXPECT_LE(relative(inertia_about_centre_of_mass(I, 1.0), expected), 1e-14);
   EXPECT_LE(relative(inertia_about_centre_of_mass(I, 2700.0), 2700.0 * expected), 1e-14);
 }
@@ -310,7 +314,7 @@ TEST(Exercise2_2, RotatedTranslatedSolidsHaveTheRotatedInertia) {
   grbd::test::Random rng(2202);
   double worst = 0.0;
   for (int n = 0; n < 300; ++n) {
-    const Matrix3 A = random_rotation(rng);
+    const Matrix3 A = rng.rotation();
     const Vector3 r = rng.vector3(-2, 2);
     const Vector3 h = rng.vector3(0.2, 1.0);
     const double density = rng.uniform(500.0, 8000.0);
@@ -357,12 +361,10 @@ TEST(MassProperties, UnitCornerTetrahedronMeshIsExact) {
   const TriangleMesh mesh = grbd::body::tetrahedron_mesh(Vector3::Zero(), Vector3::UnitX(),
                                                          Vector3::UnitY(), Vector3::UnitZ());
   const MassProperties props = mass_properties(mesh, 1.0, "corner tetrahedron");
-  Matrix3 expected = Matrix3::Constant(1.0 / 480.0);
-  expected.diagonal().setConstant(1.0 / 80.0);
   EXPECT_NEAR(props.volume, 1.0 / 6.0, 1e-16);
   EXPECT_NEAR(props.mass, 1.0 / 6.0, 1e-16);
   EXPECT_LE((props.M_r_S - Vector3::Constant(0.25)).cwiseAbs().maxCoeff(), 1e-16);
-  EXPECT_LE(relative(props.M_Theta_S, expected), 1e-14);
+  EXPECT_LE(relative(props.M_Theta_S, corner_tetrahedron_inertia()), 1e-14);
 }
 
 // Reference: Tonon's (2004) formulas for general tetrahedra (random, seeded). Tolerance 1e-12
@@ -470,9 +472,7 @@ TEST(MassProperties, CylinderMeshesConvergeAtSecondOrder) {
   const double height = 1.2;
   const double density = 7850.0;
   const double mass = density * pi * R * R * height;
-  const Matrix3 expected = Vector3(mass * (3 * R * R + height * height) / 12.0,
-                                   mass * (3 * R * R + height * height) / 12.0, 0.5 * mass * R * R)
-                               .asDiagonal();
+  const Matrix3 expected = cylinder_inertia(mass, R, height);
   std::vector<double> mass_errors, inertia_errors, h;
   for (const int n : {16, 32, 64, 128, 256}) {
     const MassProperties props =
@@ -502,7 +502,7 @@ TEST(MassProperties, InvariantUnderRigidMotions) {
   grbd::test::Random rng(2303);
   double mass_error = 0.0, position_error = 0.0, inertia_error = 0.0, moment_error = 0.0;
   for (int n = 0; n < 50; ++n) {
-    const Matrix3 A = random_rotation(rng);
+    const Matrix3 A = rng.rotation();
     const Vector3 r = rng.vector3(-2, 2);
     const MassProperties moved =
         mass_properties(grbd::body::transformed(body, A, r), density, "moved torus");
@@ -560,7 +560,7 @@ TEST(MassProperties, RejectsBadMeshesAndDensities) {
 TEST(PrincipalAxes, RecoversKnownAxesAndMoments) {
   grbd::test::Random rng(2401);
   for (int n = 0; n < 1000; ++n) {
-    const Matrix3 A = random_rotation(rng);
+    const Matrix3 A = rng.rotation();
     Vector3 d(rng.uniform(1.0, 2.0), rng.uniform(1.0, 2.0), rng.uniform(1.0, 2.0));
     std::sort(d.data(), d.data() + 3);
     if (d[1] - d[0] < 0.05 || d[2] - d[1] < 0.05) continue;
@@ -583,7 +583,7 @@ TEST(PrincipalAxes, RecoversKnownAxesAndMoments) {
 TEST(PrincipalAxes, RepeatedMomentsGiveARightHandedFrame) {
   grbd::test::Random rng(2402);
   for (int n = 0; n < 300; ++n) {
-    const Matrix3 A = random_rotation(rng);
+    const Matrix3 A = rng.rotation();
     const double a = rng.uniform(1.0, 2.0);
     const double b = a + rng.uniform(0.1, 1.0);
     const std::array<Vector3, 3> moments = {Vector3(a, a, a), Vector3(a, a, b), Vector3(a, b, b)};
@@ -606,7 +606,7 @@ TEST(PrincipalAxes, PrincipalFrameOfARotatedBoxMeshIsTheBoxFrame) {
   const Vector3 h(0.3, 0.7, 0.5);  // moments ∝ 0.74, 0.34, 0.58: ascending about y, z, x
   const Matrix3 Theta_box = box_inertia(h, 1000.0 * 8.0 * h.prod());
   for (int n = 0; n < 50; ++n) {
-    const Matrix3 A = random_rotation(rng);
+    const Matrix3 A = rng.rotation();
     const MassProperties props = mass_properties(
         grbd::body::transformed(grbd::body::box_mesh(h), A, rng.vector3(-1, 1)), 1000.0);
     const PrincipalAxes axes = principal_axes(props.M_Theta_S);
@@ -711,9 +711,7 @@ TEST(PrimitiveClosedForms, CapsuleIsACylinderPlusTwoHemispheres) {
     const double m_c = density * pi * R * R * h;
     const double m_s = density * 4.0 / 3.0 * pi * R * R * R;
     const double m_half = 0.5 * m_s;
-    Matrix3 Theta = Vector3(m_c * (3 * R * R + h * h) / 12.0, m_c * (3 * R * R + h * h) / 12.0,
-                            0.5 * m_c * R * R)
-                        .asDiagonal();
+    Matrix3 Theta = cylinder_inertia(m_c, R, h);
     for (const double side : {1.0, -1.0}) {
       const Vector3 O_prime(0.0, 0.0, side * h / 2.0);  // centre of the flat face
       const Vector3 G = O_prime + Vector3(0.0, 0.0, side * 3.0 * R / 8.0);

@@ -31,7 +31,6 @@
 
 #include "grbd/body/triangle_mesh.hpp"
 #include "grbd/core/error.hpp"
-#include "grbd/kinematics/rotation.hpp"
 #include "grbd_test/random.hpp"
 
 namespace {
@@ -97,6 +96,15 @@ std::string mesh_error_message(F&& read) {
   }
   ADD_FAILURE() << "expected a grbd::body::MeshError, none was thrown";
   return {};
+}
+
+/// The message with which require_closed_oriented() rejects the mesh read from `file`; it must
+/// start with the file's name.
+std::string rejection_message(const TriangleMesh& mesh, const fs::path& file) {
+  const std::string message =
+      mesh_error_message([&] { require_closed_oriented(mesh, file.string()); });
+  EXPECT_EQ(message.rfind(file.string() + ": ", 0), 0U) << message;
+  return message;
 }
 
 /// Reference: the divergence theorem with the field x/3, V = (1/6) Σ_faces a·(b × c).
@@ -376,7 +384,7 @@ TEST(ObjReader, NeverCrashesOnGarbage) {
 TEST(ObjWriter, RoundTripIsExact) {
   const TempDir dir;
   grbd::test::Random rng(2002);
-  const Matrix3 A = grbd::kinematics::rotation_matrix(rng.unit_quaternion());
+  const Matrix3 A = rng.rotation();
   const TriangleMesh sphere =
       grbd::body::transformed(grbd::body::icosphere_mesh(1.2345, 2), A, rng.vector3(-10, 10));
   const fs::path file = dir.write("sphere.obj", "");
@@ -457,9 +465,7 @@ TEST(MeshTopology, CountsTheBoundaryEdgesOfAnOpenBox) {
   EXPECT_EQ(t.degenerate_faces, 0U);
   EXPECT_EQ(t.invalid_indices, 0U);
   EXPECT_FALSE(t.closed_oriented_manifold());
-  const std::string message =
-      mesh_error_message([&] { require_closed_oriented(mesh, file.string()); });
-  EXPECT_EQ(message.rfind(file.string() + ": ", 0), 0U) << message;
+  const std::string message = rejection_message(mesh, file);
   EXPECT_NE(message.find("4 boundary edges"), std::string::npos) << message;
   EXPECT_NE(message.find("boundary edge (4, 5) of face 3"), std::string::npos) << message;
 }
@@ -472,9 +478,7 @@ TEST(MeshTopology, CountsInconsistentlyOrientedEdges) {
   const MeshTopology t = analyse_topology(mesh);
   EXPECT_EQ(t.inconsistent_edges, 3U);
   EXPECT_EQ(t.boundary_edges + t.non_manifold_edges + t.degenerate_faces + t.invalid_indices, 0U);
-  const std::string message =
-      mesh_error_message([&] { require_closed_oriented(mesh, file.string()); });
-  EXPECT_EQ(message.rfind(file.string() + ": ", 0), 0U) << message;
+  const std::string message = rejection_message(mesh, file);
   EXPECT_NE(message.find("3 inconsistently oriented edges"), std::string::npos) << message;
   EXPECT_NE(message.find("edge (1, 2): faces 0 and 3 both traverse it from 2 to 1"),
             std::string::npos)
@@ -490,9 +494,7 @@ TEST(MeshTopology, CountsNonManifoldEdges) {
   EXPECT_EQ(t.non_manifold_edges, 1U);
   EXPECT_EQ(t.boundary_edges, 2U);
   EXPECT_EQ(t.inconsistent_edges + t.degenerate_faces + t.invalid_indices, 0U);
-  const std::string message =
-      mesh_error_message([&] { require_closed_oriented(mesh, file.string()); });
-  EXPECT_EQ(message.rfind(file.string() + ": ", 0), 0U) << message;
+  const std::string message = rejection_message(mesh, file);
   EXPECT_NE(message.find("1 non-manifold edges"), std::string::npos) << message;
   EXPECT_NE(message.find("non-manifold edge (0, 1) shared by 3 faces"), std::string::npos)
       << message;
@@ -505,9 +507,7 @@ TEST(MeshTopology, RejectsAnInwardOrientedSurface) {
   const TriangleMesh mesh = read_obj(file);
   EXPECT_TRUE(analyse_topology(mesh).closed_oriented_manifold());
   EXPECT_DOUBLE_EQ(signed_volume(mesh), -1.0 / 6.0);
-  const std::string message =
-      mesh_error_message([&] { require_closed_oriented(mesh, file.string()); });
-  EXPECT_EQ(message.rfind(file.string() + ": ", 0), 0U) << message;
+  const std::string message = rejection_message(mesh, file);
   EXPECT_NE(message.find("-0.1666666666666666"), std::string::npos) << message;
   EXPECT_NE(message.find("inward"), std::string::npos) << message;
 }
@@ -660,7 +660,7 @@ TEST(MeshGenerators, TetrahedronRejectsCoplanarPoints) {
                grbd::InvalidArgument);
   grbd::test::Random rng(2004);
   for (int sample = 0; sample < 100; ++sample) {
-    const Matrix3 A = grbd::kinematics::rotation_matrix(rng.unit_quaternion());
+    const Matrix3 A = rng.rotation();
     auto in_plane = [&] { return Vector3(A * Vector3(rng.uniform(), rng.uniform(), 0.0)); };
     EXPECT_THROW(grbd::body::tetrahedron_mesh(in_plane(), in_plane(), in_plane(), in_plane()),
                  grbd::InvalidArgument);
@@ -772,7 +772,7 @@ TEST(MeshTransform, RigidMotionMapsEveryVertexAndKeepsTheFaces) {
   const TriangleMesh mesh = grbd::body::torus_mesh(1.0, 0.3, 16, 8);
   const double volume = signed_volume(mesh);
   for (int sample = 0; sample < 20; ++sample) {
-    const Matrix3 A = grbd::kinematics::rotation_matrix(rng.unit_quaternion());
+    const Matrix3 A = rng.rotation();
     const Vector3 r = rng.vector3(-5, 5);
     const TriangleMesh image = grbd::body::transformed(mesh, A, r);
     EXPECT_EQ(image.F, mesh.F);

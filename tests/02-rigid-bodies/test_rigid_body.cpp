@@ -3,11 +3,12 @@
 // (the body of a mesh, mass matrix, kinetic energy, angular momentum, generalized force, u̇).
 //
 // Independent references: central differences of point_position() along the exact motion with
-// constant u, q(t) = (r0 + t v, p0 exp(t ω/2)), written out here with the closed-form exp and the
-// complex-matrix product; rotation matrices of Eigen::Quaterniond (no code of chapter 1); the
-// spatial formula v_P = v_S + I_ω × I_ρ; Euler's equations written component by component; the
-// power balance of the gyroscopic term; the moment of a couple; the closed-form solution of the
-// torque-free symmetric top; and the closed-form inertia of a box.
+// constant u, q(t) = (r0 + t v, p0 exp(t ω/2)), written out with the closed-form exp and the
+// complex-matrix product (grbd_test/references.hpp); rotation matrices of Eigen::Quaterniond (no
+// code of chapter 1); the spatial formula v_P = v_S + I_ω × I_ρ; Euler's equations written
+// component by component (grbd_test/bodies.hpp); the power balance of the gyroscopic term; the
+// moment of a couple; the closed-form solution of the torque-free symmetric top; and the
+// closed-form inertia of a box.
 
 #include <gtest/gtest.h>
 
@@ -21,6 +22,7 @@
 #include "grbd/body/triangle_mesh.hpp"
 #include "grbd/core/error.hpp"
 #include "grbd/kinematics/rigid_motion.hpp"
+#include "grbd_test/bodies.hpp"
 #include "grbd_test/random.hpp"
 #include "grbd_test/references.hpp"
 
@@ -37,36 +39,15 @@ using grbd::body::RigidBody;
 using grbd::body::State;
 using grbd::kinematics::make_q;
 using grbd::kinematics::make_u;
-using grbd::kinematics::Quaternion;
+using grbd::test::exact_motion;
+using grbd::test::gyroscopic_torque;
 using grbd::test::max_abs;
+using grbd::test::random_body;
+using grbd::test::random_loads;
+using grbd::test::random_state;
+using grbd::test::reference_A_IK;
 
 constexpr double kEps = std::numeric_limits<double>::epsilon();
-
-/// The rotation matrix of the unit quaternion stored in q, by Eigen (scalar first in q, Eigen's
-/// constructor takes w, x, y, z): shares no code with rotation_matrix() of chapter 1.
-Matrix3 reference_A_IK(const Vector7& q) {
-  return Eigen::Quaterniond(q[3], q[4], q[5], q[6]).toRotationMatrix();
-}
-
-/// The exact motion for constant u = (v, ω), from q0 at t = 0 (chapter 1's closed form).
-Vector7 exact_motion(const Vector7& q0, const Vector6& u, double t) {
-  const Quaternion p0(grbd::Vector4(q0.tail<4>()));
-  const Quaternion p =
-      grbd::test::reference_product(p0, grbd::test::closed_form_exp(0.5 * t * u.tail<3>()));
-  return make_q(q0.head<3>() + t * u.head<3>(), p);
-}
-
-/// A random body: principal moments in [0.1, 3), mass in [0.5, 3).
-RigidBody random_body(grbd::test::Random& rng) {
-  return {rng.uniform(0.5, 3.0),
-          Vector3(rng.uniform(0.1, 3.0), rng.uniform(0.1, 3.0), rng.uniform(0.1, 3.0))};
-}
-
-/// A random state: r ∈ [−1, 1)³, unit p, v and ω ∈ [−2, 2)³.
-State random_state(grbd::test::Random& rng) {
-  return {make_q(rng.vector3(), rng.unit_quaternion()),
-          make_u(rng.vector3(-2, 2), rng.vector3(-2, 2))};
-}
 
 // Central differences with step δ = 1e-5, as in chapter 1: truncation δ²/6 |r⃛_P| ≤ ~1e-9 for
 // |ω| ≤ 2√3 and |ρ| ≤ √3, round-off ~1e-10; tolerance 1e-8.
@@ -168,24 +149,19 @@ TEST(Exercise2_4, MatchesHandComputedEulerEquations) {
 }
 
 // Reference: Euler's equations in components, Θ_i ω̇_i = M_i + (Θ_j − Θ_k) ω_j ω_k for (i, j, k)
-// cyclic, written out here. Terms ≤ 3·2·2 = 12, a few roundings: tolerance 1e-13.
+// cyclic, written out in grbd_test/bodies.hpp. Terms ≤ 3·2·2 = 12, a few roundings: tolerance
+// 1e-13.
 TEST(Exercise2_4, EqualsEulersEquationsInComponents) {
   grbd::test::Random rng(2401);
   double worst = 0.0;
   for (int n = 0; n < 10000; ++n) {
     const RigidBody body = random_body(rng);
     const State x = random_state(rng);
-    const Loads loads{rng.vector3(), rng.vector3()};
+    const Loads loads = random_loads(rng);
     const Vector6 h = grbd::body::newton_euler_h(body, x.u, loads);
     ASSERT_EQ(Vector3(h.head<3>()), loads.I_F);
-    const Vector3 w = x.u.tail<3>();
-    const Vector3& T = body.K_Theta;
-    for (int i = 0; i < 3; ++i) {
-      const int j = (i + 1) % 3;
-      const int k = (i + 2) % 3;
-      const double expected = loads.K_M[i] + (T[j] - T[k]) * w[j] * w[k];
-      worst = std::max(worst, std::abs(h[3 + i] - expected));
-    }
+    const Vector3 expected = loads.K_M + gyroscopic_torque(body, x.u.tail<3>());
+    worst = std::max(worst, max_abs(h.tail<3>() - expected));
   }
   EXPECT_LE(worst, 1e-13);
 }
@@ -199,7 +175,7 @@ TEST(Exercise2_4, GyroscopicTermDoesNoWork) {
   for (int n = 0; n < 10000; ++n) {
     const RigidBody body = random_body(rng);
     const State x = random_state(rng);
-    const Loads loads{rng.vector3(), rng.vector3()};
+    const Loads loads = random_loads(rng);
     const Vector6 h = grbd::body::newton_euler_h(body, x.u, loads);
     const double power = x.u.head<3>().dot(loads.I_F) + x.u.tail<3>().dot(loads.K_M);
     worst = std::max(worst, std::abs(x.u.dot(h) - power));
@@ -261,27 +237,18 @@ TEST(AngularMomentum, IsTheBodyMomentumInTheInertialFrame) {
 
 // Reference: the closed-form torque-free symmetric top (REFERENCES.md), I₁ = I₂ = I⊥:
 // A(t) = exp(t I_L/I⊥) A₀ exp(t ν e₃), ω(t) = exp(−t ν e₃) A₀ᵀ I_L/I⊥ + ν e₃, ν = ω₃(1 − I₃/I⊥),
-// with the axis–angle matrices of grbd_test/references.hpp. I_angular_momentum() of that motion
-// stays I_L(0): relative tolerance 1e-14 over t ∈ [0, 20].
+// (SymmetricTop of grbd_test/bodies.hpp). I_angular_momentum() of that motion stays I_L(0):
+// relative tolerance 1e-14 over t ∈ [0, 20].
 TEST(AngularMomentum, IsConstantAlongTheTorqueFreeSymmetricTop) {
-  using grbd::test::axis_angle_matrix;
-  const RigidBody body{1.0, Vector3(0.8, 0.8, 0.3)};
-  const double I_perp = 0.8;
-  const Vector3 omega0(0.7, -0.4, 3.0);
-  const Matrix3 A0 = axis_angle_matrix(Vector3(0.3, -1.1, 0.4));
-  const Vector3 I_L = A0 * body.K_Theta.cwiseProduct(omega0);
-  const double nu = omega0.z() * (1.0 - body.K_Theta.z() / I_perp);
+  const grbd::test::SymmetricTop top(RigidBody{1.0, Vector3(0.8, 0.8, 0.3)},
+                                     Vector3(0.7, -0.4, 3.0),
+                                     grbd::test::axis_angle_matrix(Vector3(0.3, -1.1, 0.4)));
   double worst = 0.0;
   for (double t = 0.0; t <= 20.0; t += 0.25) {
-    const Matrix3 A =
-        axis_angle_matrix(t * I_L / I_perp) * A0 * axis_angle_matrix(t * nu * Vector3::UnitZ());
-    const Vector3 omega =
-        axis_angle_matrix(-t * nu * Vector3::UnitZ()) * A0.transpose() * I_L / I_perp +
-        nu * Vector3::UnitZ();
-    const Eigen::Quaterniond e(A);
-    const State x{make_q(Vector3::Zero(), Quaternion(e.w(), e.x(), e.y(), e.z())),
-                  make_u(Vector3::Zero(), omega)};
-    worst = std::max(worst, (grbd::body::I_angular_momentum(body, x) - I_L).norm() / I_L.norm());
+    const State x{make_q(Vector3::Zero(), grbd::test::reference_quaternion(top.A(t))),
+                  make_u(Vector3::Zero(), top.omega(t))};
+    worst = std::max(
+        worst, (grbd::body::I_angular_momentum(top.body, x) - top.I_L).norm() / top.I_L.norm());
   }
   EXPECT_LE(worst, 1e-14);
 }
@@ -334,17 +301,11 @@ TEST(NewtonEulerUDot, SolvesTheNewtonEulerEquations) {
   for (int n = 0; n < 10000; ++n) {
     const RigidBody body = random_body(rng);
     const State x = random_state(rng);
-    const Loads loads{rng.vector3(), rng.vector3()};
+    const Loads loads = random_loads(rng);
     const Vector6 u_dot = grbd::body::newton_euler_u_dot(body, x.u, loads);
     Vector6 expected;
-    expected.head<3>() = loads.I_F / body.m;
-    const Vector3 w = x.u.tail<3>();
-    const Vector3& T = body.K_Theta;
-    for (int i = 0; i < 3; ++i) {
-      const int j = (i + 1) % 3;
-      const int k = (i + 2) % 3;
-      expected[3 + i] = (loads.K_M[i] + (T[j] - T[k]) * w[j] * w[k]) / T[i];
-    }
+    expected << loads.I_F / body.m,
+        (loads.K_M + gyroscopic_torque(body, x.u.tail<3>())).cwiseQuotient(body.K_Theta);
     worst = std::max(worst, max_abs(u_dot - expected));
     worst = std::max(worst, max_abs(grbd::body::mass_matrix(body) * u_dot -
                                     grbd::body::newton_euler_h(body, x.u, loads)));
@@ -390,7 +351,7 @@ TEST(RigidBodyFromMesh, TurnedAndMovedBoxGivesItsPrincipalFrame) {
       grbd::body::transformed(grbd::body::box_mesh(Vector3(a, b, c)), Q, r);
   const grbd::body::BodyFromMesh result = grbd::body::rigid_body_from_mesh(mesh, density, "box");
   const double m = 8.0 * a * b * c * density;
-  const Vector3 Theta = m / 3.0 * Vector3(a * a + b * b, a * a + c * c, b * b + c * c);
+  const Vector3 Theta = grbd::test::box_inertia(Vector3(a, b, c), m).diagonal().reverse();
   EXPECT_NEAR(result.body.m, m, 1e-13 * m);
   EXPECT_LE(max_abs(result.body.K_Theta - Theta) / Theta.maxCoeff(), 1e-13);
   EXPECT_LE(max_abs(result.M_r_S - r), 1e-13 * r.norm());

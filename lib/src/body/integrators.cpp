@@ -10,9 +10,9 @@
 #include <array>
 #include <cmath>
 #include <cstddef>
-#include <cstdio>
 #include <string>
 
+#include "grbd/core/checks.hpp"
 #include "grbd/core/error.hpp"
 #include "grbd/kinematics/rigid_motion.hpp"
 #include "grbd/kinematics/skew.hpp"
@@ -33,31 +33,15 @@ constexpr std::array<IntegratorInfo, 5> kIntegrators{{
      "|p| = 1; no energy gain if axisymmetric"},
 }};
 
-/// A double with all 17 significant digits, for error messages.
-std::string format(double x) {
-  char buffer[32];
-  std::snprintf(buffer, sizeof buffer, "%.17g", x);
-  return buffer;
-}
-
-/// Throws InvalidArgument unless the body has positive, finite m and K_Theta and the step size h
-/// is positive and finite. Comparisons only: the hot path allocates nothing.
+/// Throws InvalidArgument unless the step size h is positive and finite and the body is valid
+/// (require_valid() of rigid_body.hpp). Comparisons only: the hot path allocates nothing.
 void require_valid(const RigidBody& body, double h, const char* where) {
   if (!(h > 0.0) || !std::isfinite(h)) {
-    throw InvalidArgument(std::string(where) +
-                          ": the step size h must be positive and finite, but h = " + format(h));
+    throw InvalidArgument(
+        std::string(where) +
+        ": the step size h must be positive and finite, but h = " + format_number(h));
   }
-  if (!(body.m > 0.0) || !std::isfinite(body.m)) {
-    throw InvalidArgument(std::string(where) +
-                          ": the mass m must be positive and finite, but m = " + format(body.m));
-  }
-  for (int i = 0; i < 3; ++i) {
-    if (!(body.K_Theta[i] > 0.0) || !std::isfinite(body.K_Theta[i])) {
-      throw InvalidArgument(std::string(where) + ": the principal moment K_Theta[" +
-                            std::to_string(i) + "] must be positive and finite, but it is " +
-                            format(body.K_Theta[i]));
-    }
-  }
+  require_valid(body, where);
 }
 
 /// The kick of duration t by constant loads: v ← v + t I_F/m, K_omega ← K_omega + t Θ⁻¹ K_M.

@@ -7,29 +7,15 @@
 #include <Eigen/Eigenvalues>  // SelfAdjointEigenSolver
 #include <Eigen/LU>           // determinant()
 #include <cmath>
-#include <cstdio>
 #include <numbers>
 #include <string>
 
+#include "grbd/core/checks.hpp"
 #include "grbd/core/error.hpp"
 
 namespace grbd::body {
 
 namespace {
-
-/// A double with all 17 significant digits, for error messages.
-std::string format(double x) {
-  char buffer[32];
-  std::snprintf(buffer, sizeof buffer, "%.17g", x);
-  return buffer;
-}
-
-void require_positive(const char* function, const char* name, double x) {
-  if (!(x > 0.0) || !std::isfinite(x)) {
-    throw InvalidArgument(std::string(function) + ": expected a finite " + name + " > 0, found " +
-                          format(x));
-  }
-}
 
 /// Uniform density ρ, mass m = ρV and Θ about the centre of mass at the origin.
 MassProperties centred(double volume, double density, const Vector3& diagonal_per_mass) {
@@ -59,10 +45,7 @@ VolumeIntegrals volume_integrals(const TriangleMesh& mesh) {
 
 MassProperties mass_properties(const TriangleMesh& mesh, double density, std::string_view source) {
   require_closed_oriented(mesh, source);
-  if (!(density > 0.0) || !std::isfinite(density)) {
-    throw InvalidArgument("mass_properties (" + std::string(source) +
-                          "): expected a finite density > 0, found " + format(density));
-  }
+  require_positive_finite("mass_properties (" + std::string(source) + ")", "density", density);
   // Integrate about the centre c of the bounding box, not about the origin of M: for a body far
   // from the origin the moments about the origin are dominated by m|r_S|², and Steiner's shift
   // back to S would cancel most of their digits. Θ_S does not depend on where we integrate.
@@ -83,7 +66,7 @@ PrincipalAxes principal_axes(const Matrix3& M_Theta_S) {
   if (!M_Theta_S.allFinite() || !(asymmetry <= 1e-8 * size)) {
     throw InvalidArgument(
         "principal_axes: expected a finite symmetric inertia tensor, found max |Θ − Θᵀ| = " +
-        format(asymmetry) + " for max |Θ| = " + format(size));
+        format_number(asymmetry) + " for max |Θ| = " + format_number(size));
   }
   // Eigen's self-adjoint solver returns the eigenvalues in ascending order and orthonormal
   // eigenvectors as the columns of A_MK, so that Θ = A_MK diag(K_Theta) A_MKᵀ.
@@ -102,26 +85,26 @@ PrincipalAxes principal_axes(const Matrix3& M_Theta_S) {
 //! [principal axes]
 
 MassProperties sphere_mass_properties(double radius, double density) {
-  require_positive("sphere_mass_properties", "radius", radius);
-  require_positive("sphere_mass_properties", "density", density);
+  require_positive_finite("sphere_mass_properties", "radius", radius);
+  require_positive_finite("sphere_mass_properties", "density", density);
   const double volume = 4.0 / 3.0 * std::numbers::pi * radius * radius * radius;
   return centred(volume, density, Vector3::Constant(0.4 * radius * radius));
 }
 
 MassProperties box_mass_properties(const Vector3& half_extents, double density) {
-  require_positive("box_mass_properties", "half extent a", half_extents.x());
-  require_positive("box_mass_properties", "half extent b", half_extents.y());
-  require_positive("box_mass_properties", "half extent c", half_extents.z());
-  require_positive("box_mass_properties", "density", density);
+  require_positive_finite("box_mass_properties", "half extent a", half_extents.x());
+  require_positive_finite("box_mass_properties", "half extent b", half_extents.y());
+  require_positive_finite("box_mass_properties", "half extent c", half_extents.z());
+  require_positive_finite("box_mass_properties", "density", density);
   const Vector3 s = half_extents.cwiseAbs2();  // (a², b², c²)
   return centred(8.0 * half_extents.prod(), density,
                  Vector3(s.y() + s.z(), s.x() + s.z(), s.x() + s.y()) / 3.0);
 }
 
 MassProperties cylinder_mass_properties(double radius, double height, double density) {
-  require_positive("cylinder_mass_properties", "radius", radius);
-  require_positive("cylinder_mass_properties", "height", height);
-  require_positive("cylinder_mass_properties", "density", density);
+  require_positive_finite("cylinder_mass_properties", "radius", radius);
+  require_positive_finite("cylinder_mass_properties", "height", height);
+  require_positive_finite("cylinder_mass_properties", "density", density);
   const double R2 = radius * radius;
   const double transverse = (3.0 * R2 + height * height) / 12.0;
   return centred(std::numbers::pi * R2 * height, density,
@@ -129,13 +112,13 @@ MassProperties cylinder_mass_properties(double radius, double height, double den
 }
 
 MassProperties capsule_mass_properties(double radius, double height, double density) {
-  require_positive("capsule_mass_properties", "radius", radius);
+  require_positive_finite("capsule_mass_properties", "radius", radius);
   if (!(height >= 0.0) || !std::isfinite(height)) {
     throw InvalidArgument(
         "capsule_mass_properties: expected a finite height ≥ 0 of the straight part, found " +
-        format(height));
+        format_number(height));
   }
-  require_positive("capsule_mass_properties", "density", density);
+  require_positive_finite("capsule_mass_properties", "density", density);
   const double R = radius;
   const double h = height;
   const double m_cylinder = density * std::numbers::pi * R * R * h;
@@ -154,13 +137,13 @@ MassProperties capsule_mass_properties(double radius, double height, double dens
 }
 
 MassProperties torus_mass_properties(double R, double r, double density) {
-  require_positive("torus_mass_properties", "centre-line radius R", R);
-  require_positive("torus_mass_properties", "tube radius r", r);
-  require_positive("torus_mass_properties", "density", density);
+  require_positive_finite("torus_mass_properties", "centre-line radius R", R);
+  require_positive_finite("torus_mass_properties", "tube radius r", r);
+  require_positive_finite("torus_mass_properties", "density", density);
   if (!(r <= R)) {
     // For r > R the tube overlaps itself near the axis and Pappus's volume counts it twice.
     throw InvalidArgument("torus_mass_properties: expected a tube radius r ≤ R, found r = " +
-                          format(r) + ", R = " + format(R));
+                          format_number(r) + ", R = " + format_number(R));
   }
   const double diametral = 0.5 * R * R + 0.625 * r * r;
   return centred(2.0 * std::numbers::pi * std::numbers::pi * R * r * r, density,

@@ -6,7 +6,6 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
-#include <cstdio>
 #include <limits>
 #include <numbers>
 #include <string>
@@ -14,24 +13,11 @@
 #include <vector>
 
 #include "grbd/body/triangle_mesh.hpp"
+#include "grbd/core/checks.hpp"
 
 namespace grbd::body {
 
 namespace {
-
-/// A double with all 17 significant digits, for error messages.
-std::string format(double x) {
-  char buffer[32];
-  std::snprintf(buffer, sizeof buffer, "%.17g", x);
-  return buffer;
-}
-
-void require_positive(const char* function, const char* name, double x) {
-  if (!(x > 0.0) || !std::isfinite(x)) {
-    throw InvalidArgument(std::string(function) + ": expected a finite " + name + " > 0, found " +
-                          format(x));
-  }
-}
 
 /// Meshes stay well below the range of the int indices of Faces (and of memory).
 constexpr std::int64_t kMaxVertices = std::int64_t{1} << 24;
@@ -46,9 +32,9 @@ void require_segments(const char* function, const char* name, int n) {
 }  // namespace
 
 TriangleMesh box_mesh(const Vector3& half_extents) {
-  require_positive("box_mesh", "half extent a", half_extents.x());
-  require_positive("box_mesh", "half extent b", half_extents.y());
-  require_positive("box_mesh", "half extent c", half_extents.z());
+  require_positive_finite("box_mesh", "half extent a", half_extents.x());
+  require_positive_finite("box_mesh", "half extent b", half_extents.y());
+  require_positive_finite("box_mesh", "half extent c", half_extents.z());
   TriangleMesh mesh;
   mesh.V.resize(8, 3);
   // Vertex i has the signs (bit 0 → x, bit 1 → y, bit 2 → z) of its corner.
@@ -80,7 +66,7 @@ TriangleMesh tetrahedron_mesh(const Vector3& a, const Vector3& b, const Vector3&
     throw InvalidArgument(
         "tetrahedron_mesh: expected four finite points that are not coplanar, found the signed "
         "volume 6V = (b − a)·((c − a) × (d − a)) = " +
-        format(six_volume));
+        format_number(six_volume));
   }
   TriangleMesh mesh;
   mesh.V.resize(4, 3);
@@ -94,7 +80,7 @@ TriangleMesh tetrahedron_mesh(const Vector3& a, const Vector3& b, const Vector3&
 }
 
 TriangleMesh icosphere_mesh(double radius, int subdivisions) {
-  require_positive("icosphere_mesh", "radius", radius);
+  require_positive_finite("icosphere_mesh", "radius", radius);
   if (subdivisions < 0 || subdivisions > 10) {
     throw InvalidArgument("icosphere_mesh: expected subdivisions in [0, 10], found " +
                           std::to_string(subdivisions));
@@ -150,11 +136,11 @@ TriangleMesh icosphere_mesh(double radius, int subdivisions) {
 }
 
 TriangleMesh torus_mesh(double R, double r, int n_major, int n_minor) {
-  require_positive("torus_mesh", "centre-line radius R", R);
-  require_positive("torus_mesh", "tube radius r", r);
+  require_positive_finite("torus_mesh", "centre-line radius R", R);
+  require_positive_finite("torus_mesh", "tube radius r", r);
   if (!(r < R)) {
-    throw InvalidArgument("torus_mesh: expected a tube radius r < R, found r = " + format(r) +
-                          ", R = " + format(R));
+    throw InvalidArgument("torus_mesh: expected a tube radius r < R, found r = " +
+                          format_number(r) + ", R = " + format_number(R));
   }
   require_segments("torus_mesh", "n_major", n_major);
   require_segments("torus_mesh", "n_minor", n_minor);
@@ -190,8 +176,8 @@ TriangleMesh torus_mesh(double R, double r, int n_major, int n_minor) {
 }
 
 TriangleMesh cylinder_mesh(double radius, double height, int n) {
-  require_positive("cylinder_mesh", "radius", radius);
-  require_positive("cylinder_mesh", "height", height);
+  require_positive_finite("cylinder_mesh", "radius", radius);
+  require_positive_finite("cylinder_mesh", "height", height);
   require_segments("cylinder_mesh", "n", n);
   // Vertices: 0 the centre of the bottom, 1 the centre of the top, then the rings: bottom
   // vertex 2 + 2i and top vertex 3 + 2i at angle 2πi/n.

@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "grbd/body/triangle_mesh.hpp"
+#include "grbd/core/checks.hpp"
 
 namespace grbd::body {
 
@@ -266,18 +267,11 @@ void write_obj(const TriangleMesh& mesh, const std::filesystem::path& path,
       start = end + 1;
     }
   }
-  // std::to_chars is independent of the C locale, and 17 significant digits identify every
-  // double: read_obj() gives back exactly these numbers.
-  char buffer[32];
-  auto append_number = [&](double x) {
-    const auto result =
-        std::to_chars(buffer, buffer + sizeof buffer, x, std::chars_format::general, 17);
-    text += ' ';
-    text.append(buffer, result.ptr);
-  };
+  // format_number() is independent of the C locale, and its 17 significant digits identify
+  // every double: read_obj() gives back exactly these numbers.
   for (Eigen::Index i = 0; i < mesh.V.rows(); ++i) {
     text += 'v';
-    for (int k = 0; k < 3; ++k) append_number(mesh.V(i, k));
+    for (int k = 0; k < 3; ++k) text += ' ' + format_number(mesh.V(i, k));
     text += '\n';
   }
   for (Eigen::Index f = 0; f < mesh.F.rows(); ++f) {

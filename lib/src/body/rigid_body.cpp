@@ -7,41 +7,29 @@
 
 #include <Eigen/Geometry>  // cross()
 #include <cmath>
-#include <cstdio>
 #include <string>
 
+#include "grbd/core/checks.hpp"
 #include "grbd/core/error.hpp"
 #include "grbd/kinematics/rigid_motion.hpp"
 #include "grbd/kinematics/rotation.hpp"
 
 namespace grbd::body {
 
-namespace {
-
-/// A double with all 17 significant digits, for error messages.
-std::string format(double x) {
-  char buffer[32];
-  std::snprintf(buffer, sizeof buffer, "%.17g", x);
-  return buffer;
-}
-
-/// Throws InvalidArgument unless m and the three principal moments are positive and finite: M
-/// must be symmetric positive definite for u̇ = M⁻¹h and T = ½ uᵀMu to make sense.
 void require_valid(const RigidBody& body, std::string_view where) {
   if (!(body.m > 0.0) || !std::isfinite(body.m)) {
-    throw InvalidArgument(std::string(where) +
-                          ": the mass m must be positive and finite, but m = " + format(body.m));
+    throw InvalidArgument(
+        std::string(where) +
+        ": the mass m must be positive and finite, but m = " + format_number(body.m));
   }
   for (int i = 0; i < 3; ++i) {
     if (!(body.K_Theta[i] > 0.0) || !std::isfinite(body.K_Theta[i])) {
       throw InvalidArgument(std::string(where) + ": the principal moment K_Theta[" +
                             std::to_string(i) + "] must be positive and finite, but it is " +
-                            format(body.K_Theta[i]));
+                            format_number(body.K_Theta[i]));
     }
   }
 }
-
-}  // namespace
 
 //! [rigid body from mesh]
 BodyFromMesh rigid_body_from_mesh(const TriangleMesh& mesh, double density,

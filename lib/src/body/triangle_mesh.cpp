@@ -9,20 +9,14 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <cstdio>
 #include <string>
 #include <vector>
+
+#include "grbd/core/checks.hpp"
 
 namespace grbd::body {
 
 namespace {
-
-/// A double with all 17 significant digits, for error messages.
-std::string format(double x) {
-  char buffer[32];
-  std::snprintf(buffer, sizeof buffer, "%.17g", x);
-  return buffer;
-}
 
 /// One face's traversal of an edge, stored by the edge's smaller vertex index first so that the
 /// two traversals of an interior edge sort next to each other.
@@ -138,8 +132,8 @@ void require_closed_oriented(const TriangleMesh& mesh, std::string_view source) 
   for (Eigen::Index i = 0; i < mesh.V.rows(); ++i) {
     if (!mesh.V.row(i).allFinite()) {
       throw MeshError(where + ": expected finite vertex coordinates, found vertex " +
-                      std::to_string(i) + " = (" + format(mesh.V(i, 0)) + ", " +
-                      format(mesh.V(i, 1)) + ", " + format(mesh.V(i, 2)) + ")");
+                      std::to_string(i) + " = (" + format_number(mesh.V(i, 0)) + ", " +
+                      format_number(mesh.V(i, 1)) + ", " + format_number(mesh.V(i, 2)) + ")");
     }
   }
   const TopologyReport report = analyse(mesh);
@@ -168,7 +162,7 @@ void require_closed_oriented(const TriangleMesh& mesh, std::string_view source) 
     throw MeshError(where +
                     ": expected outward-oriented faces (counter-clockwise seen from outside) "
                     "enclosing a positive volume, found the closed surface's signed volume " +
-                    format(six_volume / 6.0) +
+                    format_number(six_volume / 6.0) +
                     (six_volume < 0.0 ? " (the faces are oriented inward)" : ""));
   }
 }
@@ -179,8 +173,8 @@ TriangleMesh transformed(const TriangleMesh& mesh, const Matrix3& A, const Vecto
     throw InvalidArgument(
         "transformed: expected a finite A with det A > 0 and a finite r (a reflection would turn "
         "the faces inward), found det A = " +
-        format(det) + ", r = (" + format(r.x()) + ", " + format(r.y()) + ", " + format(r.z()) +
-        ")");
+        format_number(det) + ", r = (" + format_number(r.x()) + ", " + format_number(r.y()) + ", " +
+        format_number(r.z()) + ")");
   }
   TriangleMesh image;
   // Row i of V is the point x_iᵀ, so the image rows are x_iᵀ Aᵀ + rᵀ.

@@ -6,21 +6,12 @@
 
 #include <Eigen/LU>  // determinant()
 #include <cmath>
-#include <cstdio>
 #include <string>
 
+#include "grbd/core/checks.hpp"
 #include "grbd/core/error.hpp"
 
 namespace grbd::kinematics {
-
-namespace {
-/// A double with all 17 significant digits, for error messages.
-std::string format(double x) {
-  char buffer[32];
-  std::snprintf(buffer, sizeof buffer, "%.17g", x);
-  return buffer;
-}
-}  // namespace
 
 //! [sandwich]
 Vector3 sandwich(const Quaternion& P, const Vector3& x) {
@@ -47,11 +38,11 @@ Quaternion quaternion_from_axis_angle(const Vector3& axis, double angle) {
     throw InvalidArgument(
         "quaternion_from_axis_angle: the axis must be a finite non-zero vector, "
         "but |axis| = " +
-        format(n));
+        format_number(n));
   }
   if (!std::isfinite(angle)) {
     throw InvalidArgument("quaternion_from_axis_angle: the angle must be finite, but it is " +
-                          format(angle));
+                          format_number(angle));
   }
   const double half = 0.5 * angle;
   return {std::cos(half), Vector3((std::sin(half) / n) * axis)};

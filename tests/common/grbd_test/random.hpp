@@ -8,6 +8,7 @@
 
 #include "grbd/core/types.hpp"
 #include "grbd/kinematics/quaternion.hpp"
+#include "grbd/kinematics/rotation.hpp"
 
 namespace grbd::test {
 
@@ -40,6 +41,8 @@ class Random {
     Vector4 K(n(engine_), n(engine_), n(engine_), n(engine_));
     return kinematics::Quaternion(Vector4(K.normalized()));
   }
+  /// A rotation matrix, uniform on SO(3): R(p) of a unit_quaternion().
+  Matrix3 rotation() { return kinematics::rotation_matrix(unit_quaternion()); }
 
   std::mt19937_64& engine() { return engine_; }
 

@@ -3,6 +3,7 @@
 /// \brief Independent reference computations shared by the tests: each is written out from its
 /// textbook formula, sharing no code with the library function it checks.
 
+#include <Eigen/Geometry>  // Quaterniond
 #include <algorithm>
 #include <cmath>
 
@@ -10,6 +11,7 @@
 
 #include "grbd/core/types.hpp"
 #include "grbd/kinematics/quaternion.hpp"
+#include "grbd/kinematics/rigid_motion.hpp"
 #include "grbd/kinematics/skew.hpp"
 
 namespace grbd::test {
@@ -53,6 +55,26 @@ inline Matrix3 axis_angle_matrix(const Vector3& theta) {
 inline Matrix3 expm(const Vector3& theta) {
   const Matrix3 theta_tilde = kinematics::skew(theta);
   return theta_tilde.exp();
+}
+
+/// The exact motion for constant u = (v, ω) from q0 at t = 0: q(t) = (r0 + t v, p0 exp(t ω/2)),
+/// with the closed-form exp and the complex-matrix product.
+inline Vector7 exact_motion(const Vector7& q0, const Vector6& u, double t) {
+  const Quaternion p0(Vector4(q0.tail<4>()));
+  const Quaternion p = reference_product(p0, closed_form_exp(0.5 * t * u.tail<3>()));
+  return kinematics::make_q(q0.head<3>() + t * u.head<3>(), p);
+}
+
+/// The rotation matrix A_IK of the unit quaternion stored in q, by Eigen::Quaterniond (scalar
+/// first in q, Eigen's constructor takes w, x, y, z): shares no code with rotation_matrix().
+inline Matrix3 reference_A_IK(const Vector7& q) {
+  return Eigen::Quaterniond(q[3], q[4], q[5], q[6]).toRotationMatrix();
+}
+
+/// The unit quaternion (scalar first) of a rotation matrix, by Eigen::Quaterniond.
+inline Quaternion reference_quaternion(const Matrix3& A) {
+  const Eigen::Quaterniond e(A);
+  return {e.w(), e.x(), e.y(), e.z()};
 }
 
 /// Max-norm of the coordinate difference of two quaternions.

@@ -3,6 +3,8 @@
 /// \brief A rigid body in its principal frame: mass matrix, kinetic energy, angular momentum,
 /// the Jacobian of a material point, and the Newton–Euler equations M u̇ = h (chapter 2).
 
+#include <string_view>
+
 #include "grbd/body/mass_properties.hpp"
 #include "grbd/core/types.hpp"
 
@@ -14,6 +16,11 @@ struct RigidBody {
   double m = 1.0;                      ///< mass [kg] > 0
   Vector3 K_Theta = Vector3::Ones();   ///< principal moments of inertia about S [kg m²] > 0
 };
+
+/// Throws InvalidArgument unless m and the three principal moments K_Theta are positive and
+/// finite: M must be symmetric positive definite for u̇ = M⁻¹h and T = ½ uᵀMu to make sense. The
+/// message starts with `where`, the name of the checking function.
+void require_valid(const RigidBody& body, std::string_view where);
 
 /// The state of one body: q = (I_r_S, p) ∈ ℝ⁷ with |p| = 1, and u = (I_v_S, K_omega) ∈ ℝ⁶.
 struct State {
