@@ -19,6 +19,15 @@ grbd_require(Eigen3_FOUND "Eigen >= 3.4" libeigen3-dev)
 find_package(SUNDIALS 6.4 QUIET CONFIG)
 grbd_require(SUNDIALS_FOUND "SUNDIALS >= 6.4" libsundials-dev)
 
+# Boost.Math (header only): Jacobi elliptic functions and elliptic integrals for the closed-form
+# references of chapter 3.
+find_package(Boost 1.74 QUIET CONFIG)
+if(Boost_FOUND)
+  find_path(GRBD_BOOST_MATH_ELLIPTIC boost/math/special_functions/jacobi_elliptic.hpp
+            HINTS ${Boost_INCLUDE_DIRS})
+endif()
+grbd_require(GRBD_BOOST_MATH_ELLIPTIC "Boost.Math (jacobi_elliptic.hpp)" libboost-math-dev)
+
 # Open MPI (chapter 8).
 find_package(MPI QUIET COMPONENTS C CXX)
 grbd_require(MPI_FOUND "MPI (Open MPI) for C and C++" "libopenmpi-dev openmpi-bin")

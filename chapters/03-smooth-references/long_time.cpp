@@ -1,0 +1,254 @@
+// Chapter 3 demo: long-time behaviour, drift against bounded oscillation.
+//
+// The torque-free asymmetric body of tumbling_body.hpp (K_Theta = (2, 3, 4) kg m²), spun up to
+// |K_omega(0)| = 2π · 20 rad/s along (1, 1, 1): one turn takes P = 2π/|ω| = 0.05 s. It is
+// integrated for T = 500 s = 10⁴ turns
+//
+//   - by three integrators of chapter 2 with h = 1 ms (50 steps per turn, h|ω| = 0.126):
+//     explicit_exp_map (whose angular velocities, hence energy and |L|, are exactly those of
+//     symplectic_exp_map and explicit_euler_normalized), lie_poisson and implicit_gyroscopic;
+//   - by CVODE, BDF (|p| projected) and Adams (not projected: CVODE projects only with BDF), at
+//     the moderate tolerance rtol = 1e-6, atol = 1e-9.
+//
+// explicit_exp_map gains energy in every step; its run is stopped once the energy has grown
+// a thousandfold.
+//
+// For every method the file `<method>.csv` is written to the data directory, one row per output
+// window. The windows last at least 4 turns, longer than the period of ω (3.2 turns), so that the
+// maximum over a window is the envelope of the error's oscillation, and grow geometrically (each
+// ends 2 % later than the one before), so that a logarithmic time axis gets evenly spaced rows; the
+// fixed-step schemes are sampled after every step, CVODE's dense output every 5 ms. The columns:
+//
+//   t_s                       end of the window [s]
+//   turns                     t / P
+//   energy_rel_error          max over the window of |E − E(0)| / E(0) [-]
+//   momentum_rel_error        max over the window of ||L| − |L(0)|| / |L(0)| [-]
+//   energy_signed_rel_error   (E − E(0)) / E(0) at the end of the window [-]
+//   momentum_signed_rel_error (|L| − |L(0)|) / |L(0)| at the end of the window [-]
+//
+// The final relative errors (and the run times) are printed in one summary line.
+//
+// Usage: `ch03_long_time <data directory>`.
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <exception>
+#include <filesystem>
+#include <functional>
+#include <iostream>
+#include <numbers>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "grbd/body/integrators.hpp"
+#include "grbd/core/error.hpp"
+#include "grbd/kinematics/rigid_motion.hpp"
+#include "tumbling_body.hpp"
+
+namespace {
+
+using namespace ch03;
+
+constexpr double kTurnsPerSecond = 20.0;
+constexpr double kTurn = 1.0 / kTurnsPerSecond;  // P [s]
+constexpr double kEndTime = 500.0;               // T [s] = 10⁴ P
+constexpr double kStep = 1e-3;                   // h [s] of the fixed-step schemes
+constexpr double kCvodeSample = 5e-3;            // CVODE's dense output every 5 ms
+constexpr double kMinWindow = 4.0 * kTurn;       // output windows last at least 4 turns …
+constexpr double kWindowGrowth = 1.02;           // … and end 2 % later than the one before
+constexpr double kGiveUp = 1e3;                  // stop once |E − E(0)| / E(0) exceeds this
+constexpr double kRtol = 1e-6;
+
+double energy(const body::RigidBody& rb, const Vector3& K_omega) {
+  return 0.5 * K_omega.dot(rb.K_Theta.cwiseProduct(K_omega));
+}
+double momentum(const body::RigidBody& rb, const Vector3& K_omega) {
+  return rb.K_Theta.cwiseProduct(K_omega).norm();
+}
+
+struct Summary {
+  std::string name;
+  double final_time = 0.0;
+  double final_energy = 0.0;    // signed
+  double final_momentum = 0.0;  // signed
+  double max_energy = 0.0;
+  double max_momentum = 0.0;
+  double seconds = 0.0;
+  double doubling_time = -1.0;  // first t with E ≥ 2 E(0), if any
+};
+
+/// Writes the windows of one run. `next(t)` returns ω at the next sample time t.
+class Recorder {
+ public:
+  Recorder(const body::RigidBody& rb, const Vector3& K_omega0, const std::filesystem::path& file,
+           std::string name)
+      : rb_(rb),
+        E0_(energy(rb, K_omega0)),
+        L0_(momentum(rb, K_omega0)),
+        out_(open_csv(file,
+                      "t_s,turns,energy_rel_error,momentum_rel_error,"
+                      "energy_signed_rel_error,momentum_signed_rel_error")) {
+    summary_.name = std::move(name);
+    out_ << "0,0,0,0,0,0\n";
+  }
+
+  /// Records ω at time t, ends the output window when it is due; returns false once the run
+  /// should stop (and then ends the window).
+  bool sample(double t, const Vector3& K_omega) {
+    const double e = (energy(rb_, K_omega) - E0_) / E0_;
+    const double l = (momentum(rb_, K_omega) - L0_) / L0_;
+    if (!std::isfinite(e) || !std::isfinite(l)) {
+      throw grbd::Error(summary_.name + " produced a non-finite state at t = " + std::to_string(t) +
+                        " s");
+    }
+    window_energy_ = std::max(window_energy_, std::abs(e));
+    window_momentum_ = std::max(window_momentum_, std::abs(l));
+    summary_.max_energy = std::max(summary_.max_energy, std::abs(e));
+    summary_.max_momentum = std::max(summary_.max_momentum, std::abs(l));
+    if (summary_.doubling_time < 0.0 && e >= 1.0) {
+      summary_.doubling_time = t;
+    }
+    last_ = {t, e, l};
+    pending_ = true;
+    const bool go_on = std::abs(e) <= kGiveUp;
+    if (t >= window_end_ * (1.0 - 1e-12) || !go_on) {
+      end_window();
+      window_end_ = std::max(t + kMinWindow, t * kWindowGrowth);
+    }
+    return go_on;
+  }
+
+  Summary finish(double seconds) {
+    if (pending_) {
+      end_window();
+    }
+    if (!out_) {
+      throw grbd::Error("writing the data of " + summary_.name + " failed");
+    }
+    summary_.final_time = last_.t;
+    summary_.final_energy = last_.energy;
+    summary_.final_momentum = last_.momentum;
+    summary_.seconds = seconds;
+    return summary_;
+  }
+
+ private:
+  void end_window() {
+    out_ << last_.t << ',' << last_.t / kTurn << ',' << window_energy_ << ',' << window_momentum_
+         << ',' << last_.energy << ',' << last_.momentum << '\n';
+    window_energy_ = window_momentum_ = 0.0;
+    pending_ = false;
+  }
+
+  struct Sample {
+    double t = 0.0;
+    double energy = 0.0;
+    double momentum = 0.0;
+  };
+  const body::RigidBody& rb_;
+  double E0_;
+  double L0_;
+  std::ofstream out_;
+  Summary summary_;
+  Sample last_;
+  double window_energy_ = 0.0;
+  double window_momentum_ = 0.0;
+  double window_end_ = kMinWindow;
+  bool pending_ = false;  // samples recorded since the last row
+};
+
+Summary run_fixed_step(const body::RigidBody& rb, const body::State& x0, body::Integrator scheme,
+                       const std::filesystem::path& data_dir) {
+  const std::string name(body::integrator_name(scheme));
+  const auto start = std::chrono::steady_clock::now();
+  Recorder recorder(rb, kin::angular_velocity(x0.u), data_dir / (name + ".csv"), name);
+  const long steps = std::lround(kEndTime / kStep);
+  const body::Loads no_loads;
+  body::State x = x0;
+  for (long n = 1; n <= steps; ++n) {
+    x = body::step(rb, x, no_loads, kStep, scheme);
+    if (!recorder.sample(static_cast<double>(n) * kStep, kin::angular_velocity(x.u))) {
+      break;
+    }
+  }
+  return recorder.finish(seconds_since(start));
+}
+
+Summary run_cvode(const body::RigidBody& rb, const body::State& x0, ode::CvodeMethod method,
+                  const std::string& name, const std::filesystem::path& data_dir) {
+  const auto start = std::chrono::steady_clock::now();
+  Recorder recorder(rb, kin::angular_velocity(x0.u), data_dir / (name + ".csv"), name);
+  ode::Tolerances tolerances;
+  tolerances.rtol = kRtol;
+  tolerances.atol = 1e-9;
+  ode::Cvode cvode(ode::free_body(rb), 0.0, ode::pack(x0), method, tolerances);
+  if (method == ode::CvodeMethod::bdf) {  // CVODE projects only with BDF
+    cvode.set_projection(ode::quaternion_projection_at(3));
+  }
+  const long samples = std::lround(kEndTime / kCvodeSample);
+  for (long n = 1; n <= samples; ++n) {
+    const double t = static_cast<double>(n) * kCvodeSample;
+    const body::State x = ode::unpack(cvode.advance(t));
+    if (!recorder.sample(t, kin::angular_velocity(x.u))) {
+      break;
+    }
+  }
+  Summary s = recorder.finish(seconds_since(start));
+  const ode::Statistics stats = cvode.statistics();
+  s.name += " (" + std::to_string(stats.steps) + " steps)";
+  return s;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  if (!check_data_dir_argument(
+          argc, argv, "ch03_long_time",
+          "writes <method>.csv for three integrators of chapter 2 and CVODE")) {
+    return 2;
+  }
+  const std::filesystem::path data_dir = argv[1];
+  try {
+    const body::RigidBody rb = tumbling_body();
+    const double spin = 2.0 * std::numbers::pi * kTurnsPerSecond / std::sqrt(3.0);
+    const body::State x0 = tumbling_start(spin);
+
+    std::vector<Summary> summaries;
+    for (const body::Integrator scheme :
+         {body::Integrator::explicit_exp_map, body::Integrator::lie_poisson,
+          body::Integrator::implicit_gyroscopic}) {
+      summaries.push_back(run_fixed_step(rb, x0, scheme, data_dir));
+    }
+    summaries.push_back(run_cvode(rb, x0, ode::CvodeMethod::bdf, "cvode_bdf", data_dir));
+    summaries.push_back(run_cvode(rb, x0, ode::CvodeMethod::adams, "cvode_adams", data_dir));
+
+    std::printf(
+        "ch03_long_time: |omega| = %.2f rad/s, turn P = %g s, T = %g s = %g turns, "
+        "h = %g s, CVODE rtol %g; relative errors at the end (energy, |L|):",
+        kin::angular_velocity(x0.u).norm(), kTurn, kEndTime, kEndTime / kTurn, kStep, kRtol);
+    for (const Summary& s : summaries) {
+      std::printf(" %s %+.2e, %+.2e", s.name.c_str(), s.final_energy, s.final_momentum);
+      if (s.final_time < kEndTime - 0.5 * kStep) {
+        std::printf(" (stopped at t = %.3g s = %.3g turns; energy doubled at t = %.3g s)",
+                    s.final_time, s.final_time / kTurn, s.doubling_time);
+      } else {
+        std::printf(" (max %.2e, %.2e)", s.max_energy, s.max_momentum);
+      }
+      std::printf(" [%.2f s];", s.seconds);
+    }
+    std::printf("\n");
+  } catch (const grbd::NotImplemented& e) {
+    std::cerr << "ch03_long_time needs the exercises of chapters 1 to 3: " << e.what() << '\n';
+    return 3;
+  } catch (const grbd::Error& e) {
+    std::cerr << "ch03_long_time: " << e.what() << '\n';
+    return 1;
+  } catch (const std::exception& e) {
+    std::cerr << "ch03_long_time: " << e.what() << '\n';
+    return 1;
+  }
+  return 0;
+}
