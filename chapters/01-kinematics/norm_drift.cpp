@@ -40,6 +40,7 @@
 #include "grbd/kinematics/rigid_motion.hpp"
 #include "grbd/kinematics/rotation.hpp"
 #include "grbd/kinematics/skew.hpp"
+#include "grbd_demo/demo.hpp"
 
 namespace {
 
@@ -141,18 +142,12 @@ std::string step_label(double h) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  if (argc != 2) {
-    std::cerr << "usage: " << (argc > 0 ? argv[0] : "ch01_norm_drift")
-              << " <data directory>\n"
-                 "  writes drift_h<h>.csv for h = 0.1, 0.05, 0.01 s into the existing directory\n";
+  if (!grbd::demo::check_arguments(
+          argc, argv, "ch01_norm_drift", {"<data directory>"},
+          "writes drift_h<h>.csv for h = 0.1, 0.05, 0.01 s into the existing directory")) {
     return 2;
   }
   const std::filesystem::path data_dir = argv[1];
-  if (!std::filesystem::is_directory(data_dir)) {
-    std::cerr << "ch01_norm_drift: the data directory '" << data_dir.string()
-              << "' does not exist or is not a directory\n";
-    return 2;
-  }
 
   // One turn per second about a generic body axis, starting from a generic orientation.
   const Vector3 K_omega = 2.0 * kPi * Vector3(1.0, 2.0, 3.0).normalized();
@@ -178,14 +173,10 @@ int main(int argc, char** argv) {
     }
     std::printf(" exp map: max ||p| - 1| = %.1e, max angle error = %.1e rad\n", expmap_norm,
                 expmap_angle);
-  } catch (const grbd::NotImplemented& e) {
-    std::cerr << "ch01_norm_drift needs the exercises of chapter 1 (product, phi_L, "
-                 "rotation_matrix, exp_S3, kinematic_map): "
-              << e.what() << '\n';
-    return 3;
-  } catch (const std::exception& e) {
-    std::cerr << "ch01_norm_drift: " << e.what() << '\n';
-    return 1;
+  } catch (...) {
+    return grbd::demo::report_exception(
+        "ch01_norm_drift",
+        "the exercises of chapter 1 (product, phi_L, rotation_matrix, exp_S3, kinematic_map)");
   }
   return 0;
 }

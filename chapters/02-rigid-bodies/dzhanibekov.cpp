@@ -42,6 +42,7 @@
 #include "grbd/core/types.hpp"
 #include "grbd/kinematics/quaternion.hpp"
 #include "grbd/kinematics/rigid_motion.hpp"
+#include "grbd_demo/demo.hpp"
 
 namespace {
 
@@ -93,18 +94,11 @@ Reference reference(const Vector3& Theta, const Vector3& omega) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  if (argc != 2) {
-    std::cerr << "usage: " << (argc > 0 ? argv[0] : "ch02_dzhanibekov")
-              << " <data directory>\n"
-                 "  writes omega.csv and flips.csv into the existing directory\n";
+  if (!grbd::demo::check_arguments(argc, argv, "ch02_dzhanibekov", {"<data directory>"},
+                                   "writes omega.csv and flips.csv into the existing directory")) {
     return 2;
   }
   const std::filesystem::path data_dir = argv[1];
-  if (!std::filesystem::is_directory(data_dir)) {
-    std::cerr << "ch02_dzhanibekov: the data directory '" << data_dir.string()
-              << "' does not exist or is not a directory\n";
-    return 2;
-  }
 
   try {
     const Vector3 half_extents(0.08, 0.04, 0.01);
@@ -187,15 +181,8 @@ int main(int argc, char** argv) {
         kEndTime, measured_half_period, ref.half_period,
         std::abs(measured_half_period - ref.half_period) / ref.half_period, max_flip_time_error,
         max_energy_error, max_momentum_error);
-  } catch (const grbd::NotImplemented& e) {
-    std::cerr << "ch02_dzhanibekov needs the exercises of chapters 1 and 2: " << e.what() << '\n';
-    return 3;
-  } catch (const grbd::Error& e) {
-    std::cerr << "ch02_dzhanibekov: " << e.what() << '\n';
-    return 1;
-  } catch (const std::exception& e) {
-    std::cerr << "ch02_dzhanibekov: " << e.what() << '\n';
-    return 1;
+  } catch (...) {
+    return grbd::demo::report_exception("ch02_dzhanibekov", "the exercises of chapters 1 and 2");
   }
   return 0;
 }

@@ -32,6 +32,7 @@
 #include "grbd/body/triangle_mesh.hpp"
 #include "grbd/core/error.hpp"
 #include "grbd/core/types.hpp"
+#include "grbd_demo/demo.hpp"
 
 namespace {
 
@@ -139,12 +140,8 @@ int main(int argc, char** argv) {
     } catch (const grbd::NotImplemented& e) {
       std::printf(" mass properties not compared (%s)\n", e.exercise().c_str());
     }
-  } catch (const grbd::Error& e) {
-    std::cerr << "ch02_make_meshes: " << e.what() << '\n';
-    return 1;
-  } catch (const std::exception& e) {
-    std::cerr << "ch02_make_meshes: " << e.what() << '\n';
-    return 1;
+  } catch (...) {
+    return grbd::demo::report_exception("ch02_make_meshes", "the exercises of chapters 1 and 2");
   }
   return 0;
 }

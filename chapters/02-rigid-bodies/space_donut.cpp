@@ -45,6 +45,7 @@
 #include "grbd/core/types.hpp"
 #include "grbd/kinematics/rigid_motion.hpp"
 #include "grbd/kinematics/rotation.hpp"
+#include "grbd_demo/demo.hpp"
 
 namespace {
 
@@ -134,19 +135,13 @@ Summary integrate(const body::RigidBody& rb, const body::State& x0, body::Integr
 }  // namespace
 
 int main(int argc, char** argv) {
-  if (argc != 3) {
-    std::cerr << "usage: " << (argc > 0 ? argv[0] : "ch02_space_donut")
-              << " <data directory> <space_donut.obj>\n"
-                 "  writes <integrator>.csv for every integrator into the existing directory\n";
+  if (!grbd::demo::check_arguments(
+          argc, argv, "ch02_space_donut", {"<data directory>", "<space_donut.obj>"},
+          "writes <integrator>.csv for every integrator into the existing directory")) {
     return 2;
   }
   const std::filesystem::path data_dir = argv[1];
   const std::filesystem::path mesh_file = argv[2];
-  if (!std::filesystem::is_directory(data_dir)) {
-    std::cerr << "ch02_space_donut: the data directory '" << data_dir.string()
-              << "' does not exist or is not a directory\n";
-    return 2;
-  }
 
   try {
     const body::TriangleMesh mesh = body::read_obj(mesh_file);
@@ -177,15 +172,8 @@ int main(int argc, char** argv) {
                   s.max_p_norm_error);
     }
     std::printf(" explicit energy law holds to %.1e\n", energy_law_deviation);
-  } catch (const grbd::NotImplemented& e) {
-    std::cerr << "ch02_space_donut needs the exercises of chapters 1 and 2: " << e.what() << '\n';
-    return 3;
-  } catch (const grbd::Error& e) {
-    std::cerr << "ch02_space_donut: " << e.what() << '\n';
-    return 1;
-  } catch (const std::exception& e) {
-    std::cerr << "ch02_space_donut: " << e.what() << '\n';
-    return 1;
+  } catch (...) {
+    return grbd::demo::report_exception("ch02_space_donut", "the exercises of chapters 1 and 2");
   }
   return 0;
 }

@@ -47,6 +47,7 @@
 #include "grbd/kinematics/rigid_motion.hpp"
 #include "grbd/kinematics/rotation.hpp"
 #include "grbd/ode/references.hpp"
+#include "grbd_demo/demo.hpp"
 #include "tumbling_body.hpp"
 
 namespace {
@@ -233,8 +234,8 @@ Nutation heavy_top(const std::filesystem::path& data_dir) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  if (!check_data_dir_argument(argc, argv, "ch03_closed_forms",
-                               "writes heavy_top.csv and nutation_bounds.csv")) {
+  if (!grbd::demo::check_arguments(argc, argv, "ch03_closed_forms", {"<data directory>"},
+                                   "writes heavy_top.csv and nutation_bounds.csv")) {
     return 2;
   }
   const std::filesystem::path data_dir = argv[1];
@@ -265,15 +266,8 @@ int main(int argc, char** argv) {
         "%.1e\n",
         nutation.measured.u_min, nutation.measured.u_max, nutation.predicted.u_min,
         nutation.predicted.u_max, nutation.max_p_norm_error);
-  } catch (const grbd::NotImplemented& e) {
-    std::cerr << "ch03_closed_forms needs the exercises of chapters 1 to 3: " << e.what() << '\n';
-    return 3;
-  } catch (const grbd::Error& e) {
-    std::cerr << "ch03_closed_forms: " << e.what() << '\n';
-    return 1;
-  } catch (const std::exception& e) {
-    std::cerr << "ch03_closed_forms: " << e.what() << '\n';
-    return 1;
+  } catch (...) {
+    return grbd::demo::report_exception("ch03_closed_forms", "the exercises of chapters 1 to 3");
   }
   return 0;
 }

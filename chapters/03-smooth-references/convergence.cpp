@@ -36,6 +36,7 @@
 #include "grbd/kinematics/rigid_motion.hpp"
 #include "grbd/ode/convergence.hpp"
 #include "grbd/ode/references.hpp"
+#include "grbd_demo/demo.hpp"
 #include "tumbling_body.hpp"
 
 namespace {
@@ -93,8 +94,8 @@ Result study(const body::RigidBody& rb, const body::State& x0, const body::Integ
 }  // namespace
 
 int main(int argc, char** argv) {
-  if (!check_data_dir_argument(argc, argv, "ch03_convergence",
-                               "writes <integrator>.csv for every integrator of chapter 2")) {
+  if (!grbd::demo::check_arguments(argc, argv, "ch03_convergence", {"<data directory>"},
+                                   "writes <integrator>.csv for every integrator of chapter 2")) {
     return 2;
   }
   const std::filesystem::path data_dir = argv[1];
@@ -128,15 +129,8 @@ int main(int argc, char** argv) {
                   r.finest_angle_error);
     }
     std::printf("\n");
-  } catch (const grbd::NotImplemented& e) {
-    std::cerr << "ch03_convergence needs the exercises of chapters 1 to 3: " << e.what() << '\n';
-    return 3;
-  } catch (const grbd::Error& e) {
-    std::cerr << "ch03_convergence: " << e.what() << '\n';
-    return 1;
-  } catch (const std::exception& e) {
-    std::cerr << "ch03_convergence: " << e.what() << '\n';
-    return 1;
+  } catch (...) {
+    return grbd::demo::report_exception("ch03_convergence", "the exercises of chapters 1 to 3");
   }
   return 0;
 }

@@ -46,6 +46,7 @@
 #include "grbd/body/integrators.hpp"
 #include "grbd/core/error.hpp"
 #include "grbd/kinematics/rigid_motion.hpp"
+#include "grbd_demo/demo.hpp"
 #include "tumbling_body.hpp"
 
 namespace {
@@ -205,8 +206,8 @@ Summary run_cvode(const body::RigidBody& rb, const body::State& x0, ode::CvodeMe
 }  // namespace
 
 int main(int argc, char** argv) {
-  if (!check_data_dir_argument(
-          argc, argv, "ch03_long_time",
+  if (!grbd::demo::check_arguments(
+          argc, argv, "ch03_long_time", {"<data directory>"},
           "writes <method>.csv for three integrators of chapter 2 and CVODE")) {
     return 2;
   }
@@ -240,15 +241,8 @@ int main(int argc, char** argv) {
       std::printf(" [%.2f s];", s.seconds);
     }
     std::printf("\n");
-  } catch (const grbd::NotImplemented& e) {
-    std::cerr << "ch03_long_time needs the exercises of chapters 1 to 3: " << e.what() << '\n';
-    return 3;
-  } catch (const grbd::Error& e) {
-    std::cerr << "ch03_long_time: " << e.what() << '\n';
-    return 1;
-  } catch (const std::exception& e) {
-    std::cerr << "ch03_long_time: " << e.what() << '\n';
-    return 1;
+  } catch (...) {
+    return grbd::demo::report_exception("ch03_long_time", "the exercises of chapters 1 to 3");
   }
   return 0;
 }

@@ -17,7 +17,6 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
-#include <iostream>
 #include <string>
 
 #include <Eigen/Core>
@@ -113,22 +112,6 @@ inline std::ofstream open_csv(const std::filesystem::path& file, const std::stri
 /// Seconds since `start`.
 inline double seconds_since(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-}
-
-/// Checks the command line of a demo that takes only its data directory (an existing
-/// directory); prints the usage or the problem to std::cerr and returns false if it is wrong.
-inline bool check_data_dir_argument(int argc, char** argv, const char* program,
-                                    const char* writes) {
-  if (argc != 2) {
-    std::cerr << "usage: " << program << " <data directory>\n  " << writes << '\n';
-    return false;
-  }
-  if (!std::filesystem::is_directory(argv[1])) {
-    std::cerr << program << ": the data directory '" << argv[1]
-              << "' does not exist or is not a directory\n";
-    return false;
-  }
-  return true;
 }
 
 }  // namespace ch03

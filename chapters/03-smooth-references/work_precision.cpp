@@ -51,6 +51,7 @@
 #include "grbd/core/error.hpp"
 #include "grbd/kinematics/rigid_motion.hpp"
 #include "grbd/ode/references.hpp"
+#include "grbd_demo/demo.hpp"
 #include "tumbling_body.hpp"
 
 namespace {
@@ -222,9 +223,9 @@ void print_cheapest(const std::vector<Method>& methods, double target,
 }  // namespace
 
 int main(int argc, char** argv) {
-  if (!check_data_dir_argument(argc, argv, "ch03_work_precision",
-                               "writes <method>.csv for the integrators of chapter 2, CVODE "
-                               "and ARKODE")) {
+  if (!grbd::demo::check_arguments(argc, argv, "ch03_work_precision", {"<data directory>"},
+                                   "writes <method>.csv for the integrators of chapter 2, CVODE "
+                                   "and ARKODE")) {
     return 2;
   }
   const std::filesystem::path data_dir = argv[1];
@@ -266,15 +267,8 @@ int main(int argc, char** argv) {
           methods, target, [](const Run& r) { return 1e3 * r.seconds; }, "ms");
     }
     std::printf(" (%.1f s)\n", seconds_since(start));
-  } catch (const grbd::NotImplemented& e) {
-    std::cerr << "ch03_work_precision needs the exercises of chapters 1 to 3: " << e.what() << '\n';
-    return 3;
-  } catch (const grbd::Error& e) {
-    std::cerr << "ch03_work_precision: " << e.what() << '\n';
-    return 1;
-  } catch (const std::exception& e) {
-    std::cerr << "ch03_work_precision: " << e.what() << '\n';
-    return 1;
+  } catch (...) {
+    return grbd::demo::report_exception("ch03_work_precision", "the exercises of chapters 1 to 3");
   }
   return 0;
 }

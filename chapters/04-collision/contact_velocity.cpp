@@ -45,6 +45,7 @@
 #include "grbd/core/types.hpp"
 #include "grbd/kinematics/rigid_motion.hpp"
 #include "grbd/kinematics/rotation.hpp"
+#include "grbd_demo/demo.hpp"
 
 namespace {
 
@@ -55,10 +56,10 @@ using grbd::Vector7;
 namespace collision = grbd::collision;
 namespace kin = grbd::kinematics;
 
-constexpr double kRadius = 0.1;     // sphere radius [m]
-constexpr double kEndTime = 4.0;    // [s]
-constexpr int kSamples = 2000;      // sample intervals over [0, kEndTime]
-constexpr double kDelta = 1e-5;     // central-difference step [s]
+constexpr double kRadius = 0.1;   // sphere radius [m]
+constexpr double kEndTime = 4.0;  // [s]
+constexpr int kSamples = 2000;    // sample intervals over [0, kEndTime]
+constexpr double kDelta = 1e-5;   // central-difference step [s]
 
 const collision::Box kBox{Vector3(0.3, 0.2, 0.1)};
 
@@ -73,8 +74,9 @@ struct Motion {
 const Motion kSphere{kin::make_q(Vector3(-1.0, -0.3, 0.5), kin::Quaternion::identity()),
                      kin::make_u(Vector3(0.5, 0.12, -0.06), Vector3(3.0, -2.0, 1.0))};
 // The box: tilted, drifting slowly, tumbling at about 1.6 rad/s.
-const Motion kBoxMotion{kin::make_q(Vector3::Zero(), kin::quaternion_from_axis_angle(Vector3(1, 1, 0), 0.3)),
-                        kin::make_u(Vector3(0.02, 0.0, 0.0), Vector3(0.4, 0.3, 1.5))};
+const Motion kBoxMotion{
+    kin::make_q(Vector3::Zero(), kin::quaternion_from_axis_angle(Vector3(1, 1, 0), 0.3)),
+    kin::make_u(Vector3(0.02, 0.0, 0.0), Vector3(0.4, 0.3, 1.5))};
 
 collision::ContactGeometry geometry(double t) {
   const Vector7 q_a = kSphere.q(t);
@@ -143,16 +145,15 @@ void run(const std::filesystem::path& dir) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  if (argc != 2) {
-    std::cerr << "usage: ch04_contact_velocity <data directory>\n";
+  if (!grbd::demo::check_arguments(argc, argv, "ch04_contact_velocity", {"<data directory>"},
+                                   "writes contact_velocity.csv into the existing directory")) {
     return 2;
   }
   try {
-    std::filesystem::create_directories(argv[1]);
     run(argv[1]);
-  } catch (const std::exception& e) {
-    std::cerr << "ch04_contact_velocity: " << e.what() << '\n';
-    return 1;
+  } catch (...) {
+    return grbd::demo::report_exception("ch04_contact_velocity",
+                                        "the exercises of chapters 1, 2 and 4");
   }
   return 0;
 }

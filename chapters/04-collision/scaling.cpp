@@ -36,10 +36,10 @@
 
 #include <algorithm>
 #include <chrono>
-#include <ctime>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
+#include <ctime>
 #include <exception>
 #include <filesystem>
 #include <fstream>
@@ -54,6 +54,7 @@
 #include "grbd/collision/broad_phase.hpp"
 #include "grbd/core/error.hpp"
 #include "grbd/core/types.hpp"
+#include "grbd_demo/demo.hpp"
 
 namespace {
 
@@ -153,9 +154,7 @@ GridTiming time_grid(const Spheres& s, int repetitions) {
 }
 
 // Repetitions for N spheres: about two million sphere-passes per measurement, at least three.
-int repetitions_for(std::size_t n) {
-  return std::max(3, static_cast<int>(2'000'000 / n));
-}
+int repetitions_for(std::size_t n) { return std::max(3, static_cast<int>(2'000'000 / n)); }
 
 // The 1-minute load average, or −1 where /proc/loadavg cannot be read: timings taken on a loaded
 // machine are slower, and the chapter says which kind its table is.
@@ -192,7 +191,8 @@ void run(const std::filesystem::path& dir) {
     Spheres sorted;
     for (int rep = 0; rep < std::max(3, repetitions / 10); ++rep) {
       const Clock::time_point start = Clock::now();
-      const std::vector<std::int32_t> order = collision::morton_order(spheres.centres, random.cell_size);
+      const std::vector<std::int32_t> order =
+          collision::morton_order(spheres.centres, random.cell_size);
       sorted = permuted(spheres, order);
       sort_s = std::min(sort_s, seconds_since(start));
     }
@@ -204,13 +204,14 @@ void run(const std::filesystem::path& dir) {
         << ',' << random.cells << ',' << random.best_build_s * per_body << ','
         << random.best_pairs_s * per_body << ',' << morton.best_build_s * per_body << ','
         << morton.best_pairs_s * per_body << '\n';
-    std::printf("%9zu %14.1f %14.1f %10.3f %14.1f %10lld  (%d repetitions; build/pairs %.1f/%.1f "
-                "random, %.1f/%.1f Morton)\n",
-                n, random.best_s * per_body, morton.best_s * per_body,
-                static_cast<double>(random.pairs) / static_cast<double>(n), sort_s * per_body,
-                static_cast<long long>(random.cells), repetitions, random.best_build_s * per_body,
-                random.best_pairs_s * per_body, morton.best_build_s * per_body,
-                morton.best_pairs_s * per_body);
+    std::printf(
+        "%9zu %14.1f %14.1f %10.3f %14.1f %10lld  (%d repetitions; build/pairs %.1f/%.1f "
+        "random, %.1f/%.1f Morton)\n",
+        n, random.best_s * per_body, morton.best_s * per_body,
+        static_cast<double>(random.pairs) / static_cast<double>(n), sort_s * per_body,
+        static_cast<long long>(random.cells), repetitions, random.best_build_s * per_body,
+        random.best_pairs_s * per_body, morton.best_build_s * per_body,
+        morton.best_pairs_s * per_body);
     if (random.pairs != morton.pairs) {
       std::printf("  note: %zu pairs in random order, %zu after reordering\n", random.pairs,
                   morton.pairs);
@@ -221,8 +222,10 @@ void run(const std::filesystem::path& dir) {
       grid.build(spheres.centres, spheres.radii, kMargin);
       grid.find_pairs(grid_pairs);
       std::sort(grid_pairs.begin(), grid_pairs.end());
-      const bool same = grid_pairs == collision::brute_force_pairs(spheres.centres, spheres.radii, kMargin);
-      std::printf("  N = 1000: the grid's pairs %s the brute-force pairs\n", same ? "equal" : "DIFFER FROM");
+      const bool same =
+          grid_pairs == collision::brute_force_pairs(spheres.centres, spheres.radii, kMargin);
+      std::printf("  N = 1000: the grid's pairs %s the brute-force pairs\n",
+                  same ? "equal" : "DIFFER FROM");
     }
   }
   std::printf("ch04_scaling: load average %.2f at the end; wrote %s\n", load_average(),
@@ -232,16 +235,14 @@ void run(const std::filesystem::path& dir) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  if (argc != 2) {
-    std::cerr << "usage: ch04_scaling <data directory>\n";
+  if (!grbd::demo::check_arguments(argc, argv, "ch04_scaling", {"<data directory>"},
+                                   "writes scaling.csv into the existing directory")) {
     return 2;
   }
   try {
-    std::filesystem::create_directories(argv[1]);
     run(argv[1]);
-  } catch (const std::exception& e) {
-    std::cerr << "ch04_scaling: " << e.what() << '\n';
-    return 1;
+  } catch (...) {
+    return grbd::demo::report_exception("ch04_scaling", "the exercises of chapter 4");
   }
   return 0;
 }
