@@ -20,7 +20,8 @@ CHAPTERS = ["ch01_kinematics", "ch02_rigid_bodies", "ch03_smooth_references", "c
             "ch05_contact_laws", "ch06_moreau_timestepping", "ch07_simulation_framework",
             "ch08_parallel_chute_flow"]
 # Chapters that are written (not only an outline): they must quote code and show figures.
-WRITTEN = ["ch01_kinematics", "ch02_rigid_bodies", "ch03_smooth_references", "ch04_collision"]
+WRITTEN = ["ch01_kinematics", "ch02_rigid_bodies", "ch03_smooth_references", "ch04_collision",
+           "ch05_contact_laws"]
 RESOURCE = re.compile(r'<(?:script|img|link)\b[^>]*?\b(?:src|href)="([^"]+)"', re.I)
 
 

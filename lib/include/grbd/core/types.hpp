@@ -8,6 +8,7 @@
 
 namespace grbd {
 
+using Vector2 = Eigen::Vector2d;                 ///< 2 × 1, e.g. a tangential percussion λ_T
 using Vector3 = Eigen::Vector3d;                 ///< 3 × 1, e.g. I_r_S, K_omega
 using Vector4 = Eigen::Vector4d;                 ///< 4 × 1, quaternion coordinates K(P)
 using Vector6 = Eigen::Matrix<double, 6, 1>;     ///< 6 × 1, velocities u = (I_v_S, K_omega)

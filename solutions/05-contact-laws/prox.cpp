@@ -1,0 +1,125 @@
+/// \file
+/// \brief Chapter 5 exercises on the contact laws: the prox onto ℝ₊, the disk and the Coulomb
+/// cone, Newton's impact law, and one SOR contact update. The prox updates of Alart–Curnier and
+/// De Saxcé and the natural map are built from them here, in the same file, so that the compiler
+/// can inline the whole contact update into the hot loop.
+
+#include <algorithm>
+#include <cmath>
+
+#include "grbd/contact/problem.hpp"
+#include "grbd/contact/prox.hpp"
+#include "grbd/core/error.hpp"
+
+namespace grbd::contact {
+
+//! [prox nonnegative]
+double prox_nonnegative(double x) {
+  // BEGIN EXERCISE 5.1: the prox onto ℝ₊
+  // Hint: the closest point of [0, ∞) to x.
+  return x > 0.0 ? x : 0.0;
+  // END EXERCISE 5.1
+}
+//! [prox nonnegative]
+
+//! [prox disk]
+Vector2 prox_disk(const Vector2& x, double radius) {
+  // BEGIN EXERCISE 5.2: the prox onto the disk of radius ρ
+  // Hint: compare ‖x‖² with ρ² first: no square root (and no division) when x is inside.
+  const double norm2 = x.squaredNorm();
+  if (norm2 <= radius * radius) return x;
+  return (radius / std::sqrt(norm2)) * x;
+  // END EXERCISE 5.2
+}
+//! [prox disk]
+
+//! [prox cone]
+Vector3 prox_cone(const Vector3& x, double mu) {
+  // BEGIN EXERCISE 5.3: the prox onto the Coulomb cone
+  // Hint: three cases: x in K_μ; x in the polar cone {μ‖x_T‖ ≤ −x_N}; otherwise the surface.
+  // Hint: on the surface, y_N = (x_N + μ‖x_T‖)/(1 + μ²) and y_T points along x_T.
+  const double x_N = x(0);
+  const double norm_T = std::sqrt(x(1) * x(1) + x(2) * x(2));
+  // x_N ≥ 0 matters for μ = 0, where 0 ≤ μ x_N would also accept the negative axis.
+  if (norm_T <= mu * x_N && x_N >= 0.0) return x;
+  if (mu * norm_T <= -x_N) return Vector3::Zero();
+  const double y_N = (x_N + mu * norm_T) / (1.0 + mu * mu);
+  // norm_T > 0 here: norm_T = 0 falls in one of the two cases above.
+  const double scale = mu * y_N / norm_T;
+  return {y_N, scale * x(1), scale * x(2)};
+  // END EXERCISE 5.3
+}
+//! [prox cone]
+
+//! [alart curnier]
+Vector3 alart_curnier_update(const Vector3& lambda, const Vector3& xi, double r_N, double r_T,
+                             double mu) {
+  const double lambda_N = prox_nonnegative(lambda(0) - r_N * xi(0));
+  const Vector2 lambda_T =
+      prox_disk(lambda.tail<2>() - r_T * xi.tail<2>(), mu * lambda_N);
+  return {lambda_N, lambda_T(0), lambda_T(1)};
+}
+//! [alart curnier]
+
+//! [de saxce]
+Vector3 de_saxce_update(const Vector3& lambda, const Vector3& xi, double r, double mu) {
+  Vector3 augmented = xi;
+  augmented(0) += mu * std::sqrt(xi(1) * xi(1) + xi(2) * xi(2));
+  return prox_cone(lambda - r * augmented, mu);
+}
+//! [de saxce]
+
+Vector3 natural_map(const Vector3& lambda, const Vector3& xi, double mu) {
+  return lambda - de_saxce_update(lambda, xi, 1.0, mu);
+}
+
+double natural_map_residual(std::span<const Vector3> lambda, std::span<const Vector3> xi,
+                            std::span<const double> mu) {
+  if (lambda.size() != xi.size() || lambda.size() != mu.size()) {
+    throw InvalidArgument("natural_map_residual: lambda, xi and mu must have one entry per "
+                          "contact; found " + std::to_string(lambda.size()) + ", " +
+                          std::to_string(xi.size()) + " and " + std::to_string(mu.size()));
+  }
+  double sum = 0.0;
+  for (std::size_t i = 0; i < lambda.size(); ++i) {
+    sum += natural_map(lambda[i], xi[i], mu[i]).squaredNorm();
+  }
+  return std::sqrt(sum);
+}
+
+//! [impact velocity]
+Vector3 impact_velocity(const Vector3& gamma_E, const Vector3& gamma_A, double eps_N,
+                        double eps_T) {
+  // BEGIN EXERCISE 5.4: the velocity of Newton's impact law
+  // Hint: the normal component restitutes with ε_N, both tangential ones with ε_T.
+  return {gamma_E(0) + eps_N * gamma_A(0), gamma_E(1) + eps_T * gamma_A(1),
+          gamma_E(2) + eps_T * gamma_A(2)};
+  // END EXERCISE 5.4
+}
+//! [impact velocity]
+
+//! [sor contact update]
+Vector3 sor_contact_update(const ContactConstraint& c, const RFactors& r, ProxForm form,
+                           std::span<const InverseMass> M_inv, std::span<Vector6> u,
+                           Vector3& lambda) {
+  // BEGIN EXERCISE 5.7: one SOR contact update
+  // Hint: γ = W_aᵀ u_a − W_bᵀ u_b, skipping a side whose index is kStatic.
+  // Hint: with ProxForm::de_saxce use the smaller of r.r_N and r.r_T as the single r-factor.
+  // Hint: M⁻¹ W Δλ is InverseMass::apply(W Δλ): six numbers per body, no 6 × 6 matrix.
+  Vector3 gamma = Vector3::Zero();
+  if (c.body_a != kStatic) gamma += c.W_a.transpose() * u[c.body_a];
+  if (c.body_b != kStatic) gamma -= c.W_b.transpose() * u[c.body_b];
+  const Vector3 xi = impact_velocity(gamma, c.gamma_A, c.eps_N, c.eps_T);
+  const Vector3 updated = form == ProxForm::alart_curnier
+                              ? alart_curnier_update(lambda, xi, r.r_N, r.r_T, c.mu)
+                              : de_saxce_update(lambda, xi, std::min(r.r_N, r.r_T), c.mu);
+  const Vector3 delta = updated - lambda;
+  if (c.body_a != kStatic) u[c.body_a] += M_inv[c.body_a].apply(c.W_a * delta);
+  if (c.body_b != kStatic) u[c.body_b] -= M_inv[c.body_b].apply(c.W_b * delta);
+  lambda = updated;
+  return xi;
+  // END EXERCISE 5.7
+}
+//! [sor contact update]
+
+}  // namespace grbd::contact
