@@ -9,6 +9,7 @@
 
 #include "grbd/contact/problem.hpp"
 #include "grbd/contact/prox.hpp"
+#include "grbd/contact/solver.hpp"
 #include "grbd/core/error.hpp"
 
 namespace grbd::contact {
@@ -121,5 +122,19 @@ Vector3 sor_contact_update(const ContactConstraint& c, const RFactors& r, ProxFo
   // END EXERCISE 5.7
 }
 //! [sor contact update]
+
+// The sweep lives in this file, next to the update it repeats, so that the compiler can inline
+// the update into the loop.
+//! [sor sweep]
+void sor_sweep(const ContactProblem& problem, std::span<const RFactors> r, ProxForm form,
+               std::span<Vector6> u, std::span<Vector3> lambda) {
+  const std::size_t n = problem.contacts.size();
+  const ContactConstraint* contacts = problem.contacts.data();
+  const std::span<const InverseMass> M_inv(problem.M_inv);
+  for (std::size_t i = 0; i < n; ++i) {
+    sor_contact_update(contacts[i], r[i], form, M_inv, u, lambda[i]);
+  }
+}
+//! [sor sweep]
 
 }  // namespace grbd::contact

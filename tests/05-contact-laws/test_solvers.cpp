@@ -921,7 +921,7 @@ TEST(SolverClosedForm, InclineSticksOrSlidesAtTheCoulombThreshold) {
         T_used << scene.contacts[0].I_t1, scene.contacts[0].I_t2;
         problem = scene.problem;
       } else {
-        problem.M_inv.push_back({1.0 / m, grbd::Matrix3::Identity()});
+        problem.M_inv.push_back({1.0 / m, grbd::Vector3::Ones()});
         problem.u_free.push_back((Vector6() << 0.0, 0.0, -g_h, 0.0, 0.0, 0.0).finished());
         grbd::contact::ContactConstraint c;
         c.body_a = 0;

@@ -70,7 +70,7 @@ ContactJacobian upright_jacobian(const Vector3& rho) {
 ContactProblem sphere_column(double m, double R, double gh, bool reversed) {
   ContactProblem p;
   for (int b = 0; b < 3; ++b) {
-    p.M_inv.push_back({1.0 / m, grbd::Matrix3::Identity() / (0.4 * m * R * R)});
+    p.M_inv.push_back({1.0 / m, grbd::Vector3::Constant(1.0 / (0.4 * m * R * R))});
     Vector6 u = Vector6::Zero();
     u(2) = -gh;
     p.u_free.push_back(u);

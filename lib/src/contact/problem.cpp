@@ -36,7 +36,7 @@ InverseMass inverse_mass(const body::RigidBody& body) {
   body::require_valid(body, "inverse_mass");
   InverseMass M_inv;
   M_inv.inv_m = 1.0 / body.m;
-  M_inv.K_Theta_inv = body.K_Theta.cwiseInverse().asDiagonal();
+  M_inv.K_Theta_inv = body.K_Theta.cwiseInverse();
   return M_inv;
 }
 
@@ -52,12 +52,12 @@ void validate(const ContactProblem& problem) {
       refuse("body " + std::to_string(b) + ": expected a finite 1/m > 0, found " +
              format_number(M.inv_m));
     }
-    if (!all_finite(M.K_Theta_inv) ||
-        (M.K_Theta_inv - M.K_Theta_inv.transpose()).norm() > 1e-12 * M.K_Theta_inv.norm()) {
-      refuse("body " + std::to_string(b) + ": K_Theta_inv must be finite and symmetric");
-    }
-    if (Eigen::LLT<Matrix3>(M.K_Theta_inv).info() != Eigen::Success) {
-      refuse("body " + std::to_string(b) + ": K_Theta_inv is not positive definite");
+    for (int k = 0; k < 3; ++k) {
+      if (!(M.K_Theta_inv(k) > 0.0) || !std::isfinite(M.K_Theta_inv(k))) {
+        refuse("body " + std::to_string(b) + ": expected finite inverse principal moments "
+               "K_Theta_inv > 0, found K_Theta_inv(" + std::to_string(k) + ") = " +
+               format_number(M.K_Theta_inv(k)));
+      }
     }
     if (!all_finite(problem.u_free[b])) {
       refuse("body " + std::to_string(b) + ": u_free is not finite");

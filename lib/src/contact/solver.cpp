@@ -444,17 +444,6 @@ std::vector<RFactors> r_factors(const ContactProblem& problem, RFactorStrategy s
   return model_r_factors(BodyModel(problem, none), strategy, alpha);
 }
 
-//! [sor sweep]
-void sor_sweep(const ContactProblem& problem, std::span<const RFactors> r, ProxForm form,
-               std::span<Vector6> u, std::span<Vector3> lambda) {
-  const std::size_t n = problem.contacts.size();
-  const ContactConstraint* contacts = problem.contacts.data();
-  const std::span<const InverseMass> M_inv(problem.M_inv);
-  for (std::size_t i = 0; i < n; ++i) {
-    sor_contact_update(contacts[i], r[i], form, M_inv, u, lambda[i]);
-  }
-}
-//! [sor sweep]
 
 std::string describe(const SolverResult& result) {
   char line[256];

@@ -69,7 +69,7 @@ inline contact::ContactProblem random_problem(Random& rng, const RandomProblemSp
     contact::InverseMass M_inv;
     M_inv.inv_m = 1.0 / rng.uniform(0.5, 3.0);
     const Vector3 Theta(rng.uniform(0.1, 3.0), rng.uniform(0.1, 3.0), rng.uniform(0.1, 3.0));
-    M_inv.K_Theta_inv = Theta.cwiseInverse().asDiagonal();
+    M_inv.K_Theta_inv = Theta.cwiseInverse();
     problem.M_inv.push_back(M_inv);
     Vector6 u;
     for (int k = 0; k < 6; ++k) u[k] = rng.uniform(-spec.u_free_scale, spec.u_free_scale);
@@ -138,7 +138,7 @@ inline Eigen::MatrixXd dense_M_inv(const contact::ContactProblem& problem) {
   for (std::size_t b = 0; b < problem.M_inv.size(); ++b) {
     const auto r = 6 * static_cast<Eigen::Index>(b);
     M_inv.block<3, 3>(r, r) = problem.M_inv[b].inv_m * Matrix3::Identity();
-    M_inv.block<3, 3>(r + 3, r + 3) = problem.M_inv[b].K_Theta_inv;
+    M_inv.block<3, 3>(r + 3, r + 3) = Matrix3(problem.M_inv[b].K_Theta_inv.asDiagonal());
   }
   return M_inv;
 }

@@ -26,16 +26,17 @@ using BodyIndex = collision::BodyIndex;
 /// The fixed world: its velocity is zero and its mass infinite.
 inline constexpr BodyIndex kStatic = collision::kStatic;
 
-/// The inverse of a body's mass matrix in u = (I_v_S, K_omega): M⁻¹ = diag(1/m I₃, K_Θ⁻¹),
-/// constant in time because the inertia is expressed in the body frame K.
+/// The inverse of a body's mass matrix in u = (I_v_S, K_omega), with K a principal frame (as
+/// body::RigidBody): M⁻¹ = diag(1/m, 1/m, 1/m, 1/Θ₁, 1/Θ₂, 1/Θ₃), constant in time because the
+/// inertia is expressed in the body frame, and diagonal, which keeps the SOR update cheap.
 struct InverseMass {
-  double inv_m = 1.0;                          ///< 1/m [1/kg]
-  Matrix3 K_Theta_inv = Matrix3::Identity();   ///< K_Θ_S⁻¹ [1/(kg m²)], symmetric positive definite
+  double inv_m = 1.0;                        ///< 1/m [1/kg]
+  Vector3 K_Theta_inv = Vector3::Ones();     ///< 1/Θ_k, inverse principal moments [1/(kg m²)]
   /// M⁻¹ x for x ∈ ℝ⁶.
   Vector6 apply(const Vector6& x) const {
     Vector6 y;
     y.head<3>() = inv_m * x.head<3>();
-    y.tail<3>() = K_Theta_inv * x.tail<3>();
+    y.tail<3>() = K_Theta_inv.cwiseProduct(x.tail<3>());
     return y;
   }
 };
@@ -68,7 +69,7 @@ struct ContactProblem {
 /// Checks a problem before a solver touches it and throws InvalidArgument naming the first bad
 /// entry (its kind and index), what was expected and what was found: body counts that disagree,
 /// a body index out of range, a contact between a body and itself or between two static sides,
-/// NaN or Inf anywhere, 1/m ≤ 0, a K_Θ⁻¹ that is not symmetric positive definite, μ < 0,
+/// NaN or Inf anywhere, 1/m ≤ 0, an inverse principal moment K_Θ⁻¹ ≤ 0, μ < 0,
 /// ε_N ∉ [0, 1], |ε_T| > 1, a Delassus block whose diagonal is not positive, keys of the wrong
 /// length.
 void validate(const ContactProblem& problem);
