@@ -34,10 +34,11 @@ struct InverseMass {
   Vector3 K_Theta_inv = Vector3::Ones();     ///< 1/Θ_k, inverse principal moments [1/(kg m²)]
   /// M⁻¹ x for x ∈ ℝ⁶.
   Vector6 apply(const Vector6& x) const {
-    Vector6 y;
-    y.head<3>() = inv_m * x.head<3>();
-    y.tail<3>() = K_Theta_inv.cwiseProduct(x.tail<3>());
-    return y;
+    // Component by component: with head<3>() and tail<3>() the compiler splits the 16-byte
+    // packet (x_2, x_3) and passes the halves through memory, a store-forwarding stall on the
+    // path of every SOR contact update (chapter 5).
+    return {inv_m * x(0),          inv_m * x(1),          inv_m * x(2),
+            K_Theta_inv(0) * x(3), K_Theta_inv(1) * x(4), K_Theta_inv(2) * x(5)};
   }
 };
 
