@@ -411,7 +411,6 @@ SolverResult run_apgd(Model& model, std::vector<Vector3>& lambda, const SolverOp
   return result;
 }
 
-template <class Problem, class Model>
 SolverResult solve_body(const ContactProblem& problem, ContactSolution& solution,
                         const SolverOptions& options, const char* name,
                         SolverResult (*method)(BodyModel&, std::vector<Vector3>&,
@@ -444,7 +443,6 @@ std::vector<RFactors> r_factors(const ContactProblem& problem, RFactorStrategy s
   return model_r_factors(BodyModel(problem, none), strategy, alpha);
 }
 
-
 std::string describe(const SolverResult& result) {
   char line[256];
   std::snprintf(line, sizeof line,
@@ -458,18 +456,15 @@ std::string describe(const SolverResult& result) {
 
 SolverResult solve_sor(const ContactProblem& problem, ContactSolution& solution,
                        const SolverOptions& options) {
-  return solve_body<ContactProblem, BodyModel>(problem, solution, options, "solve_sor",
-                                               run_sor<BodyModel>);
+  return solve_body(problem, solution, options, "solve_sor", run_sor<BodyModel>);
 }
 SolverResult solve_jor(const ContactProblem& problem, ContactSolution& solution,
                        const SolverOptions& options) {
-  return solve_body<ContactProblem, BodyModel>(problem, solution, options, "solve_jor",
-                                               run_jor<BodyModel>);
+  return solve_body(problem, solution, options, "solve_jor", run_jor<BodyModel>);
 }
 SolverResult solve_apgd(const ContactProblem& problem, ContactSolution& solution,
                         const SolverOptions& options) {
-  return solve_body<ContactProblem, BodyModel>(problem, solution, options, "solve_apgd",
-                                               run_apgd<BodyModel>);
+  return solve_body(problem, solution, options, "solve_apgd", run_apgd<BodyModel>);
 }
 SolverResult solve_sor(const LocalProblem& problem, std::vector<Vector3>& lambda,
                        const SolverOptions& options) {
