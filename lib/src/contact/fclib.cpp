@@ -588,64 +588,67 @@ void require_shape(const File& file, const MatrixHeader& h, std::int64_t rows, s
   }
 }
 
-LocalProblem read_local(const File& file) {
-  if (!file.has("/fclib_local")) {
-    if (file.has("/fclib_global")) {
-      file.fail(
-          "holds a global problem (/fclib_global), not a local one (group /fclib_local is "
-          "missing)");
+/// What a local and a global problem start with: the group of `kind` (a file of the other kind
+/// is named as such), spacedim = 3, no equality constraints, and μ, which counts the contacts.
+struct ProblemHead {
+  std::vector<double> mu;  ///< one friction coefficient per contact
+  std::int64_t n3 = 0;     ///< 3n, the number of contact unknowns
+  std::string why;         ///< where n comes from, for messages
+  /// "3n = <3n> (<why>)", the expected length of a per-unknown dataset.
+  std::string three_n() const { return "3n = " + std::to_string(n3) + " (" + why + ")"; }
+};
+
+ProblemHead read_head(const File& file, FclibKind kind) {
+  const bool local = kind == FclibKind::local;
+  const std::string root = local ? "/fclib_local" : "/fclib_global";
+  const std::string other = local ? "/fclib_global" : "/fclib_local";
+  const char* name = local ? "local" : "global";
+  const char* other_name = local ? "global" : "local";
+  if (!file.has(root)) {
+    if (file.has(other)) {
+      file.fail(std::string("holds a ") + other_name + " problem (" + other + "), not a " + name +
+                " one (group " + root + " is missing)");
     }
-    file.fail("group /fclib_local is missing: not a local FCLIB problem");
+    file.fail("group " + root + " is missing: not a " + name + " FCLIB problem");
   }
-  file.open("/fclib_local", H5I_GROUP);
-  file.require_3d("/fclib_local");
-  file.require_no_equality_constraints(FclibKind::local);
-  const std::string mu_name = "/fclib_local/vectors/mu";
+  file.open(root, H5I_GROUP);
+  file.require_3d(root);
+  file.require_no_equality_constraints(kind);
+  const std::string mu_name = root + "/vectors/mu";
+  ProblemHead head;
+  head.mu = file.friction_coefficients(mu_name);
+  head.n3 = static_cast<std::int64_t>(3 * head.mu.size());
+  head.why = contacts_text(head.mu.size(), mu_name);
+  return head;
+}
+
+LocalProblem read_local(const File& file) {
+  ProblemHead head = read_head(file, FclibKind::local);
   LocalProblem problem;
-  problem.mu = file.friction_coefficients(mu_name);
-  const std::size_t n = problem.mu.size();
-  const auto n3 = static_cast<std::int64_t>(3 * n);
-  const std::string why = contacts_text(n, mu_name);
-  problem.q = to_vector3(file.reals("/fclib_local/vectors/q", n3, false,
-                                    "3n = " + std::to_string(n3) + " (" + why + ")"));
+  problem.q = to_vector3(file.reals("/fclib_local/vectors/q", head.n3, false, head.three_n()));
   const MatrixHeader W = file.header("/fclib_local/W");
-  require_shape(file, W, n3, n3, "3n × 3n", why);
+  require_shape(file, W, head.n3, head.n3, "3n × 3n", head.why);
   problem.W = to_block_sparse(file.matrix(W));
+  problem.mu = std::move(head.mu);
   return problem;
 }
 
 GlobalProblem read_global(const File& file) {
-  if (!file.has("/fclib_global")) {
-    if (file.has("/fclib_local")) {
-      file.fail(
-          "holds a local problem (/fclib_local), not a global one (group /fclib_global is "
-          "missing)");
-    }
-    file.fail("group /fclib_global is missing: not a global FCLIB problem");
-  }
-  file.open("/fclib_global", H5I_GROUP);
-  file.require_3d("/fclib_global");
-  file.require_no_equality_constraints(FclibKind::global);
-  const std::string mu_name = "/fclib_global/vectors/mu";
-  GlobalProblem problem;
-  problem.mu = file.friction_coefficients(mu_name);
-  const std::size_t n = problem.mu.size();
-  const auto n3 = static_cast<std::int64_t>(3 * n);
-  const std::string why = contacts_text(n, mu_name);
-
+  ProblemHead head = read_head(file, FclibKind::global);
   const MatrixHeader M = file.header("/fclib_global/M");
   require_shape(file, M, M.m, M.m, "a square m × m", "m = " + std::to_string(M.m) + " rows");
   const std::int64_t m = M.m;
   const std::string m_text = "m = " + std::to_string(m) + " (the size of /fclib_global/M)";
   const MatrixHeader H = file.header("/fclib_global/H");
-  require_shape(file, H, m, n3, "m × 3n", m_text + ", " + why);
+  require_shape(file, H, m, head.n3, "m × 3n", m_text + ", " + head.why);
   const auto f = file.reals("/fclib_global/vectors/f", m, false, m_text);
-  const auto w = file.reals("/fclib_global/vectors/w", n3, false,
-                            "3n = " + std::to_string(n3) + " (" + why + ")");
+  const auto w = file.reals("/fclib_global/vectors/w", head.n3, false, head.three_n());
+  GlobalProblem problem;
   problem.f = Eigen::Map<const Eigen::VectorXd>(f.data(), static_cast<Eigen::Index>(f.size()));
   problem.w = Eigen::Map<const Eigen::VectorXd>(w.data(), static_cast<Eigen::Index>(w.size()));
   problem.M = file.matrix(M);
   problem.H = file.matrix(H);
+  problem.mu = std::move(head.mu);
   return problem;
 }
 

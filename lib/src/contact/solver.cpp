@@ -95,6 +95,13 @@ class BodyModel {
   }
   /// Makes u consistent with Λ.
   void synchronize() { u = velocities_from_percussions(problem_, lambda_); }
+  /// After JOR or APGD changed all of Λ at once: u follows Λ only when the velocity criterion
+  /// reads it, and once more at the end (done()), instead of a full pass every iteration.
+  void record(const std::vector<Vector3>& /*xi*/, bool velocity_watched) {
+    if (velocity_watched) synchronize();
+  }
+  /// Brings u up to date with the returned Λ.
+  void done() { synchronize(); }
   void sor_sweep(std::span<const RFactors> r, ProxForm form) {
     contact::sor_sweep(problem_, r, form, u, lambda_);
   }
@@ -137,8 +144,13 @@ class LocalModel {
     }
   }
   std::span<const double> watched_velocity() const { return flat(std::span<const Vector3>(seen_)); }
-  /// JOR records the velocities it saw here.
-  std::vector<Vector3>& seen() { return seen_; }
+  /// After JOR or APGD changed all of Λ at once: keeps the velocities ξ of the iteration for the
+  /// velocity criterion.
+  void record(const std::vector<Vector3>& xi, bool velocity_watched) {
+    if (velocity_watched) seen_ = xi;
+  }
+  /// Nothing to bring up to date: the local form has no body velocities.
+  void done() {}
 
  private:
   const LocalProblem& problem_;
@@ -155,9 +167,7 @@ std::vector<RFactors> model_r_factors(const Model& model, RFactorStrategy strate
   }
   double largest = 0.0;
   for (std::size_t i = 0; i < r.size(); ++i) {
-    const Matrix3 G = model.delassus(i);
-    r_factors(G, alpha);  // refuses a non-positive diagonal
-    largest = std::max(largest, G.diagonal().maxCoeff());
+    largest = std::max(largest, model.delassus(i).diagonal().maxCoeff());
   }
   std::fill(r.begin(), r.end(), RFactors{alpha / largest, alpha / largest});
   return r;
@@ -288,13 +298,10 @@ SolverResult run_jor(Model& model, std::vector<Vector3>& lambda, const SolverOpt
     for (std::size_t i = 0; i < lambda.size(); ++i) {
       lambda[i] = prox_update(options.form, lambda[i], xi[i], r[i], model.mu(i));
     }
-    if constexpr (std::is_same_v<Model, BodyModel>) {
-      model.synchronize();
-    } else {
-      model.seen() = xi;
-    }
+    model.record(xi, options.criterion == Criterion::velocity_change);
     if (monitor.after(k)) break;
   }
+  model.done();
   monitor.finish();
   result.seconds = seconds_since(start);
   return result;
@@ -325,7 +332,6 @@ SolverResult run_apgd(Model& model, std::vector<Vector3>& lambda, const SolverOp
   SolverResult result;
   result.solver = "APGD";
   const std::size_t n = model.size();
-  for (std::size_t i = 0; i < n; ++i) r_factors(model.delassus(i), 1.0);  // refuse bad blocks
   model.synchronize();
   Monitor<Model> monitor(model, options, lambda, result);
   // Step t = α/L. L starts from a power-iteration estimate of λ_max(G) and is doubled whenever
@@ -398,14 +404,10 @@ SolverResult run_apgd(Model& model, std::vector<Vector3>& lambda, const SolverOp
     x_prev = lambda;
     xi_prev = xi_x;
     L *= 0.9;
-    if constexpr (std::is_same_v<Model, BodyModel>) {
-      if (options.criterion == Criterion::velocity_change) model.synchronize();
-    } else {
-      model.seen() = xi_x;
-    }
+    model.record(xi_x, options.criterion == Criterion::velocity_change);
     if (monitor.after(k)) break;
   }
-  if constexpr (std::is_same_v<Model, BodyModel>) model.synchronize();
+  model.done();
   monitor.finish();
   result.seconds = seconds_since(start);
   return result;
@@ -439,6 +441,11 @@ SolverResult solve_local(const LocalProblem& problem, std::vector<Vector3>& lamb
 
 std::vector<RFactors> r_factors(const ContactProblem& problem, RFactorStrategy strategy,
                                 double alpha) {
+  // The solvers check these once before they compute r-factors; here the caller gets the same.
+  SolverOptions options;
+  options.alpha = alpha;
+  validate_options(options, "r_factors");
+  validate(problem);
   std::vector<Vector3> none;
   return model_r_factors(BodyModel(problem, none), strategy, alpha);
 }

@@ -91,7 +91,8 @@ struct ContactSolution {
   std::vector<Vector6> u;       ///< end velocity per body
 };
 
-/// The r-factors of every contact of `problem` for `strategy` and relaxation α.
+/// The r-factors of every contact of `problem` for `strategy` and relaxation α. Throws
+/// InvalidArgument for a problem that validate() refuses or α outside (0, 2).
 std::vector<RFactors> r_factors(const ContactProblem& problem, RFactorStrategy strategy,
                                 double alpha);
 
