@@ -73,18 +73,6 @@ if(GRBD_MISSING_PACKAGES)
   message(FATAL_ERROR "Missing dependencies. On Debian 12: sudo apt-get install ${_grbd_missing}")
 endif()
 
-# The FCLIB problems of shared/data/fclib (chapter 5's tests and bench program): real contact
-# problems from LMGC90 and Siconos, read in place and never copied into the tree.
-set(_fclib_default "")
-foreach(_dir ${PROJECT_SOURCE_DIR}/../shared/data/fclib /work/shared/data/fclib)
-  if(_fclib_default STREQUAL "" AND EXISTS ${_dir}/Spheres-i099-356-679.hdf5)
-    get_filename_component(_fclib_default ${_dir} ABSOLUTE)
-  endif()
-endforeach()
-set(GRBD_FCLIB_DATA_DIR "${_fclib_default}" CACHE PATH
-    "Folder with the FCLIB problems of shared/data/fclib (chapter 5 tests)")
-if(GRBD_FCLIB_DATA_DIR STREQUAL "")
-  message(WARNING "The FCLIB problems (shared/data/fclib) were not found: the chapter 5 FCLIB "
-                  "tests will skip. Set GRBD_FCLIB_DATA_DIR to the folder that holds them.")
-endif()
-
+# The FCLIB problems that chapter 5's tests, bench program and figure solve ship with the
+# repository (chapters/05-contact-laws/data, see its README for their origin and licence).
+set(GRBD_FCLIB_DATA_DIR ${PROJECT_SOURCE_DIR}/chapters/05-contact-laws/data)

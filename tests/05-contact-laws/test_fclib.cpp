@@ -1,5 +1,5 @@
 // Chapter 5: the FCLIB reader and the local problem ξ = W λ + q — reading the three FCLIB files of
-// shared/data/fclib, the three sparse storage kinds, the refusal of malformed files, the
+// chapters/05-contact-laws/data, the three sparse storage kinds, the refusal of malformed files, the
 // block-sparse Delassus matrix and the conversion of a global problem to local form.
 //
 // Independent references: the file contents as listed by a separate program on HDF5's own
@@ -53,15 +53,6 @@ constexpr const char* kSpheres = "Spheres-i099-356-679.hdf5";
 
 fs::path data_file(const char* name) { return fs::path(GRBD_FCLIB_DATA_DIR) / name; }
 
-bool have_data() { return !std::string(GRBD_FCLIB_DATA_DIR).empty(); }
-
-#define GRBD_REQUIRE_FCLIB_DATA()                                                              \
-  do {                                                                                         \
-    if (!have_data()) {                                                                        \
-      GTEST_SKIP() << "GRBD_FCLIB_DATA_DIR is empty: the FCLIB problems of shared/data/fclib " \
-                      "were not found at configure time";                                      \
-    }                                                                                          \
-  } while (false)
 
 // A fresh folder under the system's temporary folder, removed with everything in it.
 class TempDir {
@@ -306,10 +297,9 @@ LocalProblem small_problem() {
 }
 
 // ---------------------------------------------------------------------------------------------
-// FclibReader: the three files of shared/data/fclib.
+// FclibReader: the three files of chapters/05-contact-laws/data.
 
 TEST(FclibReader, InfoOfTheThreeFiles) {
-  GRBD_REQUIRE_FCLIB_DATA();
   const auto perio = grbd::contact::read_fclib_info(data_file(kPerioBox));
   EXPECT_EQ(perio.kind, FclibKind::local);
   EXPECT_EQ(perio.contacts, 60);
@@ -339,7 +329,6 @@ TEST(FclibReader, InfoOfTheThreeFiles) {
 }
 
 TEST(FclibReader, LocalFilesReadConsistently) {
-  GRBD_REQUIRE_FCLIB_DATA();
   struct Case {
     const char* file;
     std::size_t contacts;
@@ -382,7 +371,6 @@ TEST(FclibReader, LocalFilesReadConsistently) {
 // entries within block (268, 268). The reader passes both on unchanged and validate() accepts both:
 // symmetry is not part of its contract.
 TEST(FclibReader, SymmetryOfTheLocalFiles) {
-  GRBD_REQUIRE_FCLIB_DATA();
   const Eigen::MatrixXd perio(
       grbd::contact::read_fclib_matrix(data_file(kPerioBox), "/fclib_local/W"));
   EXPECT_LE(max_abs(perio - perio.transpose()), 1e-14 * max_abs(perio));
@@ -403,7 +391,6 @@ TEST(FclibReader, SymmetryOfTheLocalFiles) {
 }
 
 TEST(FclibReader, GlobalFileSizes) {
-  GRBD_REQUIRE_FCLIB_DATA();
   const GlobalProblem g = grbd::contact::read_fclib_global(data_file(kSpheres));
   EXPECT_EQ(g.M.rows(), 12000);
   EXPECT_EQ(g.M.cols(), 12000);
@@ -429,7 +416,6 @@ TEST(FclibReader, GlobalFileSizes) {
 // touches enter, provided M couples none of them to the others (checked): then
 // Hᵀ M⁻¹ H = H_Sᵀ M_SS⁻¹ H_S and Hᵀ M⁻¹ f = H_Sᵀ M_SS⁻¹ f_S exactly.
 TEST(FclibReader, ToLocalOfSpheresMatchesDenseCholesky) {
-  GRBD_REQUIRE_FCLIB_DATA();
   const GlobalProblem g = grbd::contact::read_fclib_global(data_file(kSpheres));
   std::vector<int> S;
   {
@@ -486,7 +472,6 @@ TEST(FclibReader, ToLocalOfSpheresMatchesDenseCholesky) {
 // FclibReader: malformed files.
 
 TEST(FclibReader, MissingDatasetsAreNamed) {
-  GRBD_REQUIRE_FCLIB_DATA();
   TempDir dir;
   struct Case {
     const char* object;
@@ -519,7 +504,6 @@ TEST(FclibReader, MissingDatasetsAreNamed) {
 }
 
 TEST(FclibReader, TruncatedAndForeignFilesAreRefusedByName) {
-  GRBD_REQUIRE_FCLIB_DATA();
   TempDir dir;
   for (const char* name : {kPerioBox, kSpheres}) {
     SCOPED_TRACE(name);
@@ -571,7 +555,6 @@ TEST(FclibReader, TruncatedAndForeignFilesAreRefusedByName) {
 }
 
 TEST(FclibReader, MalformedDatasetsAreRefusedByName) {
-  GRBD_REQUIRE_FCLIB_DATA();
   TempDir dir;
   int count = 0;
   const auto copy = [&](const char* name) {
@@ -871,7 +854,6 @@ TEST(LocalProblem, MultiplyMatchesEigenSparseProduct) {
 }
 
 TEST(LocalProblem, MultiplyOnFclibMatricesMatchesEigen) {
-  GRBD_REQUIRE_FCLIB_DATA();
   grbd::test::Random random(5);
   for (const char* name : {kPerioBox, kCapsules}) {
     SCOPED_TRACE(name);

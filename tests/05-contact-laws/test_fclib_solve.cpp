@@ -1,5 +1,5 @@
-// Chapter 5: grbd's solvers on the FCLIB problems of shared/data/fclib, to the residuals that
-// Siconos 4.4 reaches on them (shared/data/fclib/README.md): ‖F‖/‖q‖ ≤ 4.6e-8 on PerioBox-60
+// Chapter 5: grbd's solvers on the FCLIB problems of chapters/05-contact-laws/data, to the residuals that
+// Siconos 4.4 reaches on them (chapters/05-contact-laws/data/README.md): ‖F‖/‖q‖ ≤ 4.6e-8 on PerioBox-60
 // (NSGS), ≤ 2.7e-10 on Capsules-286 (NSGS) and ≤ 1.1e-8 on Spheres-356 (NSGS).
 //
 // Independent references: the Siconos residuals above; the natural map recomputed here from
@@ -28,13 +28,6 @@ using grbd::contact::SolverResult;
 std::filesystem::path data_file(const std::string& name) {
   return std::filesystem::path(GRBD_FCLIB_DATA_DIR) / name;
 }
-
-#define REQUIRE_FCLIB_DATA()                                                              \
-  do {                                                                                    \
-    if (std::string(GRBD_FCLIB_DATA_DIR).empty()) {                                       \
-      GTEST_SKIP() << "shared/data/fclib not found; set GRBD_FCLIB_DATA_DIR to run this"; \
-    }                                                                                     \
-  } while (false)
 
 SolverOptions to_tolerance(double tol, int max_iterations) {
   SolverOptions options;
@@ -93,23 +86,19 @@ void expect_siconos_residual_with_sor_and_apgd(const std::string& file, std::siz
 }
 
 TEST(FclibSolve, PerioBox60ReachesSiconosResidualWithSorAndApgd) {
-  REQUIRE_FCLIB_DATA();
   expect_siconos_residual_with_sor_and_apgd("LMGC_100_PR_PerioBox-i00361-60-03000.hdf5", 60, 4.6e-8,
                                             20000, 1e-5);
 }
 
 TEST(FclibSolve, Capsules286ReachesSiconosResidualWithSorAndApgd) {
-  REQUIRE_FCLIB_DATA();
   expect_siconos_residual_with_sor_and_apgd("Capsules-i125-1213.hdf5", 286, 2.7e-10, 40000, 1e-6);
 }
 
 TEST(FclibSolve, Spheres356GlobalReachesSiconosResidualWithSorAndApgd) {
-  REQUIRE_FCLIB_DATA();
   expect_siconos_residual_with_sor_and_apgd("Spheres-i099-356-679.hdf5", 356, 1.1e-8, 20000, 1e-5);
 }
 
 TEST(FclibSolve, NonConvergenceIsReportedNotHidden) {
-  REQUIRE_FCLIB_DATA();
   const LocalProblem problem =
       grbd::contact::read_fclib_as_local(data_file("Capsules-i125-1213.hdf5"));
   std::vector<Vector3> lambda;
