@@ -142,10 +142,10 @@ std::string step_label(double h) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  if (!grbd::demo::check_arguments(
+  if (const auto exit_code = grbd::demo::check_arguments(
           argc, argv, "ch01_norm_drift", {"<data directory>"},
           "writes drift_h<h>.csv for h = 0.1, 0.05, 0.01 s into the existing directory")) {
-    return 2;
+    return *exit_code;
   }
   const std::filesystem::path data_dir = argv[1];
 

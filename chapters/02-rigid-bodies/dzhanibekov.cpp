@@ -94,9 +94,9 @@ Reference reference(const Vector3& Theta, const Vector3& omega) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  if (!grbd::demo::check_arguments(argc, argv, "ch02_dzhanibekov", {"<data directory>"},
+  if (const auto exit_code = grbd::demo::check_arguments(argc, argv, "ch02_dzhanibekov", {"<data directory>"},
                                    "writes omega.csv and flips.csv into the existing directory")) {
-    return 2;
+    return *exit_code;
   }
   const std::filesystem::path data_dir = argv[1];
 

@@ -107,11 +107,16 @@ Comparison compare(const NamedMesh& m) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  const auto print_usage = [](std::ostream& out) {
+    out << "usage: ch02_make_meshes <output directory>\n"
+           "  writes space_donut.obj, box.obj, tetrahedron.obj, icosphere.obj and cylinder.obj\n";
+  };
+  if (grbd::demo::wants_help(argc, argv)) {
+    print_usage(std::cout);
+    return 0;
+  }
   if (argc != 2) {
-    std::cerr << "usage: " << (argc > 0 ? argv[0] : "ch02_make_meshes")
-              << " <output directory>\n"
-                 "  writes space_donut.obj, box.obj, tetrahedron.obj, icosphere.obj and "
-                 "cylinder.obj\n";
+    print_usage(std::cerr);
     return 2;
   }
   const std::filesystem::path out_dir = argv[1];

@@ -135,10 +135,10 @@ Summary integrate(const body::RigidBody& rb, const body::State& x0, body::Integr
 }  // namespace
 
 int main(int argc, char** argv) {
-  if (!grbd::demo::check_arguments(
+  if (const auto exit_code = grbd::demo::check_arguments(
           argc, argv, "ch02_space_donut", {"<data directory>", "<space_donut.obj>"},
           "writes <integrator>.csv for every integrator into the existing directory")) {
-    return 2;
+    return *exit_code;
   }
   const std::filesystem::path data_dir = argv[1];
   const std::filesystem::path mesh_file = argv[2];

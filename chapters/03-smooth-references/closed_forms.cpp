@@ -234,9 +234,9 @@ Nutation heavy_top(const std::filesystem::path& data_dir) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  if (!grbd::demo::check_arguments(argc, argv, "ch03_closed_forms", {"<data directory>"},
+  if (const auto exit_code = grbd::demo::check_arguments(argc, argv, "ch03_closed_forms", {"<data directory>"},
                                    "writes heavy_top.csv and nutation_bounds.csv")) {
-    return 2;
+    return *exit_code;
   }
   const std::filesystem::path data_dir = argv[1];
   try {

@@ -94,9 +94,9 @@ Result study(const body::RigidBody& rb, const body::State& x0, const body::Integ
 }  // namespace
 
 int main(int argc, char** argv) {
-  if (!grbd::demo::check_arguments(argc, argv, "ch03_convergence", {"<data directory>"},
+  if (const auto exit_code = grbd::demo::check_arguments(argc, argv, "ch03_convergence", {"<data directory>"},
                                    "writes <integrator>.csv for every integrator of chapter 2")) {
-    return 2;
+    return *exit_code;
   }
   const std::filesystem::path data_dir = argv[1];
   try {

@@ -206,10 +206,10 @@ Summary run_cvode(const body::RigidBody& rb, const body::State& x0, ode::CvodeMe
 }  // namespace
 
 int main(int argc, char** argv) {
-  if (!grbd::demo::check_arguments(
+  if (const auto exit_code = grbd::demo::check_arguments(
           argc, argv, "ch03_long_time", {"<data directory>"},
           "writes <method>.csv for three integrators of chapter 2 and CVODE")) {
-    return 2;
+    return *exit_code;
   }
   const std::filesystem::path data_dir = argv[1];
   try {

@@ -70,7 +70,7 @@ struct Reference {
   body::State x;
   ode::Statistics statistics;
 };
-//! [cvode reference]
+// [cvode reference]
 inline Reference cvode_reference(const body::RigidBody& rb, const body::State& x0, double T,
                                  ode::CvodeMethod method = ode::CvodeMethod::bdf,
                                  double rtol = 1e-12) {
@@ -85,7 +85,7 @@ inline Reference cvode_reference(const body::RigidBody& rb, const body::State& x
   const Eigen::VectorXd y = cvode.advance(T);
   return {ode::unpack(y), cvode.statistics()};
 }
-//! [cvode reference]
+// [cvode reference]
 
 /// A second, independent reference at time T: ARKODE's explicit Runge–Kutta pair of order 8 at
 /// rtol 1e-13, atol 1e-15 (not projected: ARKODE has no projection).

@@ -223,10 +223,10 @@ void print_cheapest(const std::vector<Method>& methods, double target,
 }  // namespace
 
 int main(int argc, char** argv) {
-  if (!grbd::demo::check_arguments(argc, argv, "ch03_work_precision", {"<data directory>"},
+  if (const auto exit_code = grbd::demo::check_arguments(argc, argv, "ch03_work_precision", {"<data directory>"},
                                    "writes <method>.csv for the integrators of chapter 2, CVODE "
                                    "and ARKODE")) {
-    return 2;
+    return *exit_code;
   }
   const std::filesystem::path data_dir = argv[1];
   try {

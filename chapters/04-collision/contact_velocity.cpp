@@ -145,9 +145,9 @@ void run(const std::filesystem::path& dir) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  if (!grbd::demo::check_arguments(argc, argv, "ch04_contact_velocity", {"<data directory>"},
+  if (const auto exit_code = grbd::demo::check_arguments(argc, argv, "ch04_contact_velocity", {"<data directory>"},
                                    "writes contact_velocity.csv into the existing directory")) {
-    return 2;
+    return *exit_code;
   }
   try {
     run(argv[1]);

@@ -235,9 +235,9 @@ void run(const std::filesystem::path& dir) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  if (!grbd::demo::check_arguments(argc, argv, "ch04_scaling", {"<data directory>"},
+  if (const auto exit_code = grbd::demo::check_arguments(argc, argv, "ch04_scaling", {"<data directory>"},
                                    "writes scaling.csv into the existing directory")) {
-    return 2;
+    return *exit_code;
   }
   try {
     run(argv[1]);

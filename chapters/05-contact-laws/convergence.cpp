@@ -94,9 +94,9 @@ void write_columns(const std::filesystem::path& path, const std::vector<std::str
 }  // namespace
 
 int main(int argc, char** argv) {
-  if (!grbd::demo::check_arguments(argc, argv, kProgram, {"<data directory>"},
+  if (const auto exit_code = grbd::demo::check_arguments(argc, argv, kProgram, {"<data directory>"},
                                    "writes convergence.csv, deep.csv, alpha.csv and convergence.txt")) {
-    return 2;
+    return *exit_code;
   }
   try {
     const std::filesystem::path dir = argv[1];

@@ -42,11 +42,12 @@ using grbd::contact::SolverResult;
 
 constexpr const char* kProgram = "ch05_fclib";
 
-int usage(const std::string& problem) {
-  if (!problem.empty()) std::cerr << kProgram << ": " << problem << '\n';
-  std::cerr << "usage: " << kProgram
-            << " <data directory> <FCLIB file or folder>... [--tol T] [--max-iterations N]\n"
-               "  solves FCLIB problems with SOR, JOR and APGD; writes fclib.txt and fclib.csv\n";
+/// Prints the usage, after `problem` if there is one, to `out`; returns the exit code 2.
+int usage(const std::string& problem, std::ostream& out = std::cerr) {
+  if (!problem.empty()) out << kProgram << ": " << problem << '\n';
+  out << "usage: " << kProgram
+      << " <data directory> <FCLIB file or folder>... [--tol T] [--max-iterations N]\n"
+         "  solves FCLIB problems with SOR, JOR and APGD; writes fclib.txt and fclib.csv\n";
   return 2;
 }
 
@@ -67,6 +68,10 @@ struct Run {
 }  // namespace
 
 int main(int argc, char** argv) {
+  if (grbd::demo::wants_help(argc, argv)) {
+    usage("", std::cout);
+    return 0;
+  }
   if (argc < 3) return usage("");
   const fs::path dir = argv[1];
   if (!fs::is_directory(dir)) {

@@ -20,6 +20,7 @@
 #include "grbd/kinematics/skew.hpp"
 #include "grbd_test/random.hpp"
 #include "grbd_test/references.hpp"
+#include "grbd_test/worst_case.hpp"
 
 namespace {
 
@@ -46,32 +47,35 @@ constexpr double pi = std::numbers::pi;
 // round-off of |v| (one ulp of a ≤ 2π) moves cos and sin by at most ~1e-15: tolerance 1e-14.
 TEST(Exercise1_5, ClosedFormAlongAnAxisAndUnitNorm) {
   grbd::test::Random rng(2501);
-  double worst = 0.0;
-  double worst_norm = 0.0;
+  WorstCase worst;
+  WorstCase worst_norm;
   for (int n = 0; n < kSamples; ++n) {
     const Vector3 axis = rng.unit_vector3();
     const double a = rng.uniform(-2.0 * pi, 2.0 * pi);
     const Quaternion p = exp_S3(a * axis);
-    worst = std::max(worst, distance(p, closed_form_exp(axis, a)));
-    worst_norm = std::max(worst_norm, std::abs(p.norm() - 1.0));
+    worst.update(distance(p, closed_form_exp(axis, a)), n,
+                 [&] { return describe("axis", axis, "a", a, "exp_S3(a axis)", p); });
+    worst_norm.update(std::abs(p.norm() - 1.0), n,
+                      [&] { return describe("axis", axis, "a", a, "exp_S3(a axis)", p); });
   }
-  EXPECT_LE(worst, 1e-14);
-  EXPECT_LE(worst_norm, 1e-15) << "cos² + sin² = 1 to a few ulps";
+  EXPECT_LE(worst.value(), 1e-14) << worst;
+  EXPECT_LE(worst_norm.value(), 1e-15) << "cos² + sin² = 1 to a few ulps; " << worst_norm;
 }
 
 // Reference: t ↦ exp(t n) is a one-parameter subgroup, exp(a n) exp(b n) = exp((a + b) n); the
 // product through complex matrices.
 TEST(Exercise1_5, OneParameterSubgroup) {
   grbd::test::Random rng(2502);
-  double worst = 0.0;
+  WorstCase worst;
   for (int n = 0; n < kSamples; ++n) {
     const Vector3 axis = rng.unit_vector3();
     const double a = rng.uniform(-pi, pi);
     const double b = rng.uniform(-pi, pi);
-    worst = std::max(worst, distance(reference_product(exp_S3(a * axis), exp_S3(b * axis)),
-                                     exp_S3((a + b) * axis)));
+    worst.update(distance(reference_product(exp_S3(a * axis), exp_S3(b * axis)),
+                          exp_S3((a + b) * axis)),
+                 n, [&] { return describe("axis", axis, "a", a, "b", b); });
   }
-  EXPECT_LE(worst, 1e-14);
+  EXPECT_LE(worst.value(), 1e-14) << worst;
 }
 
 // Reference: the Taylor series exp(0, v) = (1 − |v|²/2, (1 − |v|²/6) v) + O(|v|⁴), which for
@@ -79,14 +83,15 @@ TEST(Exercise1_5, OneParameterSubgroup) {
 // (2 ulps), and v = 0 must give exactly 1, not 0/0.
 TEST(Exercise1_5, AccurateForTinyArguments) {
   grbd::test::Random rng(2503);
-  double worst_relative = 0.0;
+  WorstCase worst_relative;
   for (int n = 0; n < kSamples; ++n) {
     const Vector3 v = rng.uniform(1e-11, 1e-9) * rng.unit_vector3();
     const Quaternion p = exp_S3(v);
     EXPECT_EQ(p.p0(), 1.0);  // 1 − |v|²/2 = 1 − O(1e-18) rounds to 1
-    worst_relative = std::max(worst_relative, (p.p_r() - v).norm() / v.norm());
+    worst_relative.update((p.p_r() - v).norm() / v.norm(), n,
+                          [&] { return describe("v", v, "exp_S3(v)", p); });
   }
-  EXPECT_LE(worst_relative, 4.5e-16);
+  EXPECT_LE(worst_relative.value(), 4.5e-16) << worst_relative;
   EXPECT_EQ(exp_S3(Vector3::Zero()).coeffs(), Quaternion::identity().coeffs());
   const Vector3 tiny(1e-200, -2e-200, 3e-200);  // |v|² underflows to 0
   EXPECT_EQ(exp_S3(tiny).p0(), 1.0);
@@ -102,8 +107,8 @@ TEST(Exercise1_5, AccurateForTinyArguments) {
 // where acos(p0) would lose about half of the digits; atan2 keeps them all.
 TEST(Exercise1_6, InvertsTheExponentialNearZeroNearPiAndAtRandom) {
   grbd::test::Random rng(2601);
-  double worst = 0.0;
-  double worst_relative = 0.0;
+  WorstCase worst;
+  WorstCase worst_relative;
   for (int n = 0; n < kSamples; ++n) {
     const Vector3 axis = rng.unit_vector3();
     double a = rng.uniform(0.0, pi);
@@ -112,13 +117,17 @@ TEST(Exercise1_6, InvertsTheExponentialNearZeroNearPiAndAtRandom) {
     const Quaternion p = closed_form_exp(axis, a);
     const Vector3 v = log_S3(p);
     // The logarithm itself, relative to |v| = a (which is ≥ 5e-10): a few ulps.
-    worst_relative = std::max(worst_relative, (v - a * axis).norm() / a);
+    worst_relative.update((v - a * axis).norm() / a, n, [&] {
+      return describe("axis", axis, "a", a, "p", p, "log_S3(p)", v);
+    });
     // exp∘log = id, exp in closed form from the computed v.
     const double b = v.norm();
-    worst = std::max(worst, distance(closed_form_exp(v / b, b), p));
+    worst.update(distance(closed_form_exp(v / b, b), p), n, [&] {
+      return describe("axis", axis, "a", a, "p", p, "log_S3(p)", v);
+    });
   }
-  EXPECT_LE(worst_relative, 1e-15);
-  EXPECT_LE(worst, 1e-15);
+  EXPECT_LE(worst_relative.value(), 1e-15) << worst_relative;
+  EXPECT_LE(worst.value(), 1e-15) << worst;
 }
 
 // Reference: log∘exp = id on the ball |v| < π (the principal branch), exp by the exercise.
@@ -126,15 +135,16 @@ TEST(Exercise1_6, InvertsTheExponentialNearZeroNearPiAndAtRandom) {
 // relative error of a few ulps at any |v| < π, so the round trip is good to ~1e-15 · |v|.
 TEST(Exercise1_6, LogOfExpIsIdentityOnTheBallOfRadiusPi) {
   grbd::test::Random rng(2602);
-  double worst = 0.0;
+  WorstCase worst;
   for (int n = 0; n < kSamples; ++n) {
     double a = rng.uniform(0.0, pi);
     if (n % 4 == 1) a = rng.uniform(1e-12, 1e-6);
     if (n % 4 == 2) a = pi - rng.uniform(1e-12, 1e-6);
     const Vector3 v = a * rng.unit_vector3();
-    worst = std::max(worst, (log_S3(exp_S3(v)) - v).norm() / std::max(a, 1e-300));
+    worst.update((log_S3(exp_S3(v)) - v).norm() / std::max(a, 1e-300), n,
+                 [&] { return describe("v", v); });
   }
-  EXPECT_LE(worst, 1e-14);
+  EXPECT_LE(worst.value(), 1e-14) << worst;
 }
 
 // Reference: log 1 = 0, and at p = −1 the documented choice π e_x; |v| ∈ [0, π] always.
@@ -158,12 +168,13 @@ TEST(Exercise1_6, IdentityMinusOneAndPrincipalRange) {
 // doubles the relative error, so ~10 ulps of ‖R‖ ≈ 1 are expected: tolerance 1e-14.
 TEST(Exercise1_7, EqualsTheMatrixExponential) {
   grbd::test::Random rng(2701);
-  double worst = 0.0;
+  WorstCase worst;
   for (int n = 0; n < 2000; ++n) {
     const Vector3 theta = rng.uniform(0.0, 2.0 * pi) * rng.unit_vector3();
-    worst = std::max(worst, max_abs(exp_SO3(theta) - expm(theta)));
+    worst.update(max_abs(exp_SO3(theta) - expm(theta)), n,
+                 [&] { return describe("theta", theta); });
   }
-  EXPECT_LE(worst, 1e-14);
+  EXPECT_LE(worst.value(), 1e-14) << worst;
 }
 
 // Reference: the matrix exponential again, for tiny and small rotation vectors, where the
@@ -171,18 +182,20 @@ TEST(Exercise1_7, EqualsTheMatrixExponential) {
 // must give I exactly.
 TEST(Exercise1_7, AccurateForSmallAngles) {
   grbd::test::Random rng(2702);
-  double worst = 0.0;
+  WorstCase worst;
   for (int n = 0; n < kSamples; ++n) {
     const double a = std::pow(10.0, rng.uniform(-12.0, -2.0));
     const Vector3 theta = a * rng.unit_vector3();
     // I + θ̃ + θ̃²/2 has O(1), O(a) and O(a²) entries; the error is relative to the largest.
-    worst = std::max(worst, max_abs(exp_SO3(theta) - expm(theta)));
+    worst.update(max_abs(exp_SO3(theta) - expm(theta)), n,
+                 [&] { return "exp_SO3 = expm, " + describe("theta", theta); });
     // The skew part, R − Rᵀ = 2 sin a ñ, must be accurate relative to a (not just to 1).
     const Matrix3 R = exp_SO3(theta);
     const Matrix3 skew_part = 0.5 * (R - R.transpose());
-    worst = std::max(worst, max_abs(skew_part - std::sin(a) / a * skew(theta)) / a);
+    worst.update(max_abs(skew_part - std::sin(a) / a * skew(theta)) / a, n,
+                 [&] { return "skew part relative to |θ|, " + describe("theta", theta); });
   }
-  EXPECT_LE(worst, 1e-15);
+  EXPECT_LE(worst.value(), 1e-15) << worst;
   EXPECT_EQ(exp_SO3(Vector3::Zero()), Matrix3::Identity());
 }
 
@@ -190,7 +203,7 @@ TEST(Exercise1_7, AccurateForSmallAngles) {
 // are the other way round S³ → SO(3)), also for tiny θ; and RᵀR = I, det R = 1.
 TEST(Exercise1_7, EqualsTheRotationMatrixOfTheQuaternion) {
   grbd::test::Random rng(2703);
-  double worst = 0.0;
+  WorstCase worst;
   for (int n = 0; n < kSamples; ++n) {
     const double a =
         n % 2 == 0 ? rng.uniform(0.0, 2.0 * pi) : std::pow(10.0, rng.uniform(-12.0, -2.0));
@@ -198,11 +211,14 @@ TEST(Exercise1_7, EqualsTheRotationMatrixOfTheQuaternion) {
     const Matrix3 R = exp_SO3(theta);
     const Matrix3 expected =
         grbd::kinematics::rotation_matrix(grbd::kinematics::quaternion_from_rotation_vector(theta));
-    worst = std::max(worst, max_abs(R - expected));
-    worst = std::max(worst, max_abs(R.transpose() * R - Matrix3::Identity()));
-    worst = std::max(worst, std::abs(R.determinant() - 1.0));
+    worst.update(max_abs(R - expected), n,
+                 [&] { return "R(exp_S3(θ/2)), " + describe("theta", theta); });
+    worst.update(max_abs(R.transpose() * R - Matrix3::Identity()), n,
+                 [&] { return "RᵀR = I, " + describe("theta", theta); });
+    worst.update(std::abs(R.determinant() - 1.0), n,
+                 [&] { return "det R = 1, " + describe("theta", theta); });
   }
-  EXPECT_LE(worst, 1e-14);
+  EXPECT_LE(worst.value(), 1e-14) << worst;
 }
 
 // ----------------------------------------------------------------------------------------------
@@ -214,16 +230,18 @@ TEST(Exercise1_7, EqualsTheRotationMatrixOfTheQuaternion) {
 // read from the diagonal of R (Shepperd), still a few ulps: tolerance 1e-14 absolute.
 TEST(LogSO3, InvertsTheExponential) {
   grbd::test::Random rng(2801);
-  double worst = 0.0;
+  WorstCase worst;
   for (int n = 0; n < 5000; ++n) {
     double a = rng.uniform(0.0, pi);
     if (n % 4 == 1) a = std::pow(10.0, rng.uniform(-12.0, -2.0));
     if (n % 4 == 2) a = pi - std::pow(10.0, rng.uniform(-9.0, -2.0));
     const Vector3 theta = a * rng.unit_vector3();
-    worst = std::max(worst, (grbd::kinematics::log_SO3(expm(theta)) - theta).norm());
-    worst = std::max(worst, (grbd::kinematics::log_SO3(exp_SO3(theta)) - theta).norm());
+    worst.update((grbd::kinematics::log_SO3(expm(theta)) - theta).norm(), n,
+                 [&] { return "log_SO3(expm(θ)), " + describe("theta", theta); });
+    worst.update((grbd::kinematics::log_SO3(exp_SO3(theta)) - theta).norm(), n,
+                 [&] { return "log_SO3(exp_SO3(θ)), " + describe("theta", theta); });
   }
-  EXPECT_LE(worst, 1e-14);
+  EXPECT_LE(worst.value(), 1e-14) << worst;
 }
 
 // Reference: at |θ| = π, θ and −θ are the same rotation; either is a correct logarithm.
@@ -250,16 +268,20 @@ TEST(RotationVector, RoundTripAndSignOfQuaternion) {
   using grbd::kinematics::quaternion_from_rotation_vector;
   using grbd::kinematics::rotation_vector;
   grbd::test::Random rng(2901);
-  double worst = 0.0;
+  WorstCase worst;
   for (int n = 0; n < kSamples; ++n) {
     const Vector3 axis = rng.unit_vector3();
     const double a = rng.uniform(0.0, pi);
     const Quaternion p = quaternion_from_rotation_vector(a * axis);
-    worst = std::max(worst, distance(p, closed_form_exp(axis, 0.5 * a)));
-    worst = std::max(worst, (rotation_vector(p) - a * axis).norm());
-    worst = std::max(worst, (rotation_vector(-p) - a * axis).norm());
+    worst.update(distance(p, closed_form_exp(axis, 0.5 * a)), n, [&] {
+      return "quaternion_from_rotation_vector, " + describe("axis", axis, "a", a);
+    });
+    worst.update((rotation_vector(p) - a * axis).norm(), n,
+                 [&] { return "rotation_vector(p), " + describe("axis", axis, "a", a, "p", p); });
+    worst.update((rotation_vector(-p) - a * axis).norm(), n,
+                 [&] { return "rotation_vector(−p), " + describe("axis", axis, "a", a, "p", p); });
     ASSERT_LE(rotation_vector(rng.unit_quaternion()).norm(), pi);
   }
-  EXPECT_LE(worst, 1e-14);
+  EXPECT_LE(worst.value(), 1e-14) << worst;
   EXPECT_THROW((void)rotation_vector(Quaternion(0, 0, 0, 0)), grbd::InvalidArgument);
 }

@@ -24,6 +24,7 @@
 #include "grbd_test/bodies.hpp"
 #include "grbd_test/random.hpp"
 #include "grbd_test/references.hpp"
+#include "grbd_test/worst_case.hpp"
 
 namespace {
 
@@ -60,47 +61,47 @@ constexpr double kDifferenceTol = 1e-8;
 // Reference: central differences of the exact motion q(t) = (r0 + t v, p0 exp(t ω/2)).
 TEST(Exercise1_8, MatchesCentralDifferencesOfTheExactMotion) {
   grbd::test::Random rng(3801);
-  double worst = 0.0;
+  WorstCase worst;
   for (int n = 0; n < 2000; ++n) {
     const auto [q, u] = random_state(rng);
     const Vector7 difference = (exact_motion(q, u, kH) - exact_motion(q, u, -kH)) / (2.0 * kH);
-    worst = std::max(worst,
-                     (grbd::kinematics::kinematic_map(q) * u - difference).cwiseAbs().maxCoeff());
+    worst.update((grbd::kinematics::kinematic_map(q) * u - difference).cwiseAbs().maxCoeff(), n,
+                 [&] { return describe("q", q, "u", u); });
   }
-  EXPECT_LE(worst, kDifferenceTol);
+  EXPECT_LE(worst.value(), kDifferenceTol) << worst;
 }
 
 // Reference: φ_L(p) is |p| times an orthogonal matrix, so F(q)ᵀ F(q) = diag(I₃, ¼|p|² I₃), also
 // for non-unit p. Entries O(1 + |p|²): tolerance 1e-14 relative to that.
 TEST(Exercise1_8, GramMatrixIsDiagonal) {
   grbd::test::Random rng(3802);
-  double worst = 0.0;
+  WorstCase worst;
   for (int n = 0; n < 10000; ++n) {
     const Quaternion p = rng.quaternion();
     const Matrix76 F = grbd::kinematics::kinematic_map(make_q(rng.vector3(), p));
     Eigen::Matrix<double, 6, 6> expected = Eigen::Matrix<double, 6, 6>::Identity();
     expected.bottomRightCorner<3, 3>() *= 0.25 * p.squared_norm();
-    worst = std::max(
-        worst, (F.transpose() * F - expected).cwiseAbs().maxCoeff() / (1.0 + p.squared_norm()));
+    worst.update((F.transpose() * F - expected).cwiseAbs().maxCoeff() / (1.0 + p.squared_norm()),
+                 n, [&] { return describe("p", p); });
   }
-  EXPECT_LE(worst, 1e-14);
+  EXPECT_LE(worst.value(), 1e-14) << worst;
 }
 
 // Reference: d/dt |p|² = 2 pᵀṗ = 0 along q̇ = F(q) u (|p| is a first integral), and İ_r_S = I_v_S
 // exactly, for any p.
 TEST(Exercise1_8, QuaternionRateIsTangentAndTranslationIsExact) {
   grbd::test::Random rng(3803);
-  double worst = 0.0;
+  WorstCase worst;
   for (int n = 0; n < 10000; ++n) {
     const Quaternion p = rng.quaternion();
     const Vector7 q = make_q(rng.vector3(), p);
     const Vector6 u = make_u(rng.vector3(), rng.vector3(-2, 2));
     const Vector7 qdot = grbd::kinematics::kinematic_map(q) * u;
     ASSERT_EQ(Vector3(qdot.head<3>()), Vector3(u.head<3>()));
-    worst = std::max(
-        worst, std::abs(p.coeffs().dot(qdot.tail<4>())) / (p.squared_norm() * u.tail<3>().norm()));
+    worst.update(std::abs(p.coeffs().dot(qdot.tail<4>())) / (p.squared_norm() * u.tail<3>().norm()),
+                 n, [&] { return describe("q", q, "u", u); });
   }
-  EXPECT_LE(worst, 1e-14);
+  EXPECT_LE(worst.value(), 1e-14) << worst;
 }
 
 // ----------------------------------------------------------------------------------------------
@@ -111,24 +112,24 @@ TEST(Exercise1_8, QuaternionRateIsTangentAndTranslationIsExact) {
 TEST(Exercise1_9, MatchesCentralDifferencesOfPointPosition) {
   using grbd::kinematics::point_position;
   grbd::test::Random rng(3901);
-  double worst = 0.0;
+  WorstCase worst;
   for (int n = 0; n < 2000; ++n) {
     const auto [q, u] = random_state(rng);
     const Vector3 rho = rng.vector3();
     const Vector3 difference = (point_position(exact_motion(q, u, kH), rho) -
                                 point_position(exact_motion(q, u, -kH), rho)) /
                                (2.0 * kH);
-    worst = std::max(
-        worst, (grbd::kinematics::point_velocity(q, u, rho) - difference).cwiseAbs().maxCoeff());
+    worst.update((grbd::kinematics::point_velocity(q, u, rho) - difference).cwiseAbs().maxCoeff(),
+                 n, [&] { return describe("q", q, "u", u, "rho", rho); });
   }
-  EXPECT_LE(worst, kDifferenceTol);
+  EXPECT_LE(worst.value(), kDifferenceTol) << worst;
 }
 
 // Reference: the inertial-frame (spatial) formula v_P = v_S + I_ω × (A ρ), I_ω = A K_ω, with A
 // the axis–angle matrix of the orientation. Entries O(|ω||ρ|) ≤ ~6: tolerance 1e-14.
 TEST(Exercise1_9, EqualsTheSpatialVelocityFormula) {
   grbd::test::Random rng(3902);
-  double worst = 0.0;
+  WorstCase worst;
   for (int n = 0; n < 10000; ++n) {
     const Vector3 theta = rng.uniform(0.0, pi) * rng.unit_vector3();
     const Quaternion p = closed_form_exp(theta.normalized(), 0.5 * theta.norm());
@@ -139,9 +140,11 @@ TEST(Exercise1_9, EqualsTheSpatialVelocityFormula) {
     const Vector3 expected = v + (A * omega).cross(A * rho);
     const Vector3 found =
         grbd::kinematics::point_velocity(make_q(rng.vector3(), p), make_u(v, omega), rho);
-    worst = std::max(worst, (found - expected).cwiseAbs().maxCoeff());
+    worst.update((found - expected).cwiseAbs().maxCoeff(), n, [&] {
+      return describe("p", p, "v", v, "omega", omega, "rho", rho);
+    });
   }
-  EXPECT_LE(worst, 1e-14);
+  EXPECT_LE(worst.value(), 1e-14) << worst;
 }
 
 // Reference: rigidity. Two points of one body keep their distance, so their relative velocity is
@@ -151,18 +154,19 @@ TEST(Exercise1_9, VelocityFieldIsRigid) {
   using grbd::kinematics::point_position;
   using grbd::kinematics::point_velocity;
   grbd::test::Random rng(3903);
-  double worst = 0.0;
+  WorstCase worst;
   for (int n = 0; n < 10000; ++n) {
     const auto [q, u] = random_state(rng);
     const Vector3 a = rng.vector3();
     const Vector3 b = rng.vector3();
     const double relative = (point_velocity(q, u, a) - point_velocity(q, u, b))
                                 .dot(point_position(q, a) - point_position(q, b));
-    worst = std::max(worst, std::abs(relative) / (u.tail<3>().norm() * (a - b).squaredNorm()));
+    worst.update(std::abs(relative) / (u.tail<3>().norm() * (a - b).squaredNorm()), n,
+                 [&] { return describe("q", q, "u", u, "a", a, "b", b); });
     const Vector6 translation = make_u(u.head<3>(), Vector3::Zero());
     ASSERT_EQ(point_velocity(q, translation, a), Vector3(u.head<3>()));
   }
-  EXPECT_LE(worst, 1e-13);  // ratio of two O(1) products, each a few ulps; ~450 ulps of margin
+  EXPECT_LE(worst.value(), 1e-13) << worst;  // ratio of two O(1) products; ~450 ulps of margin
 }
 
 // ----------------------------------------------------------------------------------------------
@@ -189,32 +193,34 @@ TEST(Coordinates, PackAndUnpack) {
 // Reference: q̇ = F(q) u, and ṗ = ½ p (0, ω) with the product through complex matrices.
 TEST(QDot, IsTheKinematicMapTimesU) {
   grbd::test::Random rng(4002);
-  double worst = 0.0;
+  WorstCase worst;
   for (int n = 0; n < 1000; ++n) {
     const auto [q, u] = random_state(rng);
     const Vector7 qdot = grbd::kinematics::q_dot(q, u);
     const Quaternion pdot = 0.5 * reference_product(orientation(q), Quaternion::pure(u.tail<3>()));
-    worst = std::max(worst, (qdot.tail<4>() - pdot.coeffs()).cwiseAbs().maxCoeff());
-    worst = std::max(worst, (qdot.head<3>() - u.head<3>()).cwiseAbs().maxCoeff());
+    worst.update((qdot.tail<4>() - pdot.coeffs()).cwiseAbs().maxCoeff(), n,
+                 [&] { return "ṗ = ½ p (0, ω), " + describe("q", q, "u", u); });
+    worst.update((qdot.head<3>() - u.head<3>()).cwiseAbs().maxCoeff(), n,
+                 [&] { return "ṙ = v, " + describe("q", q, "u", u); });
   }
-  EXPECT_LE(worst, 1e-14);
+  EXPECT_LE(worst.value(), 1e-14) << worst;
 }
 
 // Reference: I_r_P = I_r_S + A ρ with the classical axis–angle matrix A of a known rotation.
 TEST(PointPosition, IsCentreOfMassPlusRotatedOffset) {
   grbd::test::Random rng(4003);
-  double worst = 0.0;
+  WorstCase worst;
   for (int n = 0; n < 10000; ++n) {
     const Vector3 theta = rng.uniform(0.0, pi) * rng.unit_vector3();
     const Quaternion p = closed_form_exp(theta.normalized(), 0.5 * theta.norm());
     const Vector3 r = rng.vector3();
     const Vector3 rho = rng.vector3();
     const Vector3 expected = r + axis_angle_matrix(theta) * rho;
-    worst = std::max(
-        worst,
-        (grbd::kinematics::point_position(make_q(r, p), rho) - expected).cwiseAbs().maxCoeff());
+    worst.update(
+        (grbd::kinematics::point_position(make_q(r, p), rho) - expected).cwiseAbs().maxCoeff(), n,
+        [&] { return describe("theta", theta, "p", p, "r", r, "rho", rho); });
   }
-  EXPECT_LE(worst, 1e-14);
+  EXPECT_LE(worst.value(), 1e-14) << worst;
 }
 
 // Reference: the exact growth law of explicit Euler. p_{n+1} = p_n + (h/2) p_n (0, ω) adds to p_n
@@ -230,17 +236,19 @@ TEST(ExplicitEulerDrift, NormSquaredGrowsByTheExactFactorEveryStep) {
   for (double h : {1e-3, 1e-2, 1e-1}) {
     for (int c = 0; c < 5; ++c) {
       auto [q, u] = random_state(rng);
+      const Vector7 q_start = q;
       const Vector3 r0 = q.head<3>();
       const double factor = 1.0 + 0.25 * h * h * u.tail<3>().squaredNorm();
       const double n0 = q.tail<4>().squaredNorm();
-      double worst_step = 0.0;
+      WorstCase worst_step;
       for (int n = 0; n < N; ++n) {
         const double before = q.tail<4>().squaredNorm();
         q = grbd::kinematics::explicit_euler_step(q, u, h);
-        worst_step =
-            std::max(worst_step, std::abs(q.tail<4>().squaredNorm() / before / factor - 1.0));
+        worst_step.update(std::abs(q.tail<4>().squaredNorm() / before / factor - 1.0), [&] {
+          return describe("step", n, "h", h, "case", c, "q_0", q_start, "u", u, "q_{n+1}", q);
+        });
       }
-      EXPECT_LE(worst_step, 1e-13) << "h = " << h;
+      EXPECT_LE(worst_step.value(), 1e-13) << "h = " << h << "; " << worst_step;
       const double total = q.tail<4>().squaredNorm() / (n0 * std::pow(factor, N));
       EXPECT_NEAR(total, 1.0, N * 1e-15) << "h = " << h << ", factor^N = " << std::pow(factor, N);
       const Vector3 r_exact = r0 + N * h * u.head<3>();
@@ -277,13 +285,13 @@ TEST(ExpMapStep, IsExactForConstantAngularVelocity) {
 // Reference: one exp-map step equals the exact motion at t = h (closed-form exp, complex product).
 TEST(ExpMapStep, OneStepIsTheExactMotion) {
   grbd::test::Random rng(4202);
-  double worst = 0.0;
+  WorstCase worst;
   for (int n = 0; n < 10000; ++n) {
     const auto [q, u] = random_state(rng);
     const double h = rng.uniform(0.0, 1.0);
-    worst = std::max(
-        worst,
-        (grbd::kinematics::exp_map_step(q, u, h) - exact_motion(q, u, h)).cwiseAbs().maxCoeff());
+    worst.update(
+        (grbd::kinematics::exp_map_step(q, u, h) - exact_motion(q, u, h)).cwiseAbs().maxCoeff(), n,
+        [&] { return describe("q", q, "u", u, "h", h); });
   }
-  EXPECT_LE(worst, 1e-14);
+  EXPECT_LE(worst.value(), 1e-14) << worst;
 }

@@ -24,6 +24,7 @@
 #include "grbd/kinematics/skew.hpp"
 #include "grbd_test/random.hpp"
 #include "grbd_test/references.hpp"
+#include "grbd_test/worst_case.hpp"
 
 namespace {
 
@@ -55,29 +56,34 @@ Quaternion axis_angle_quaternion(const Vector3& n, double angle) {
 // Reference: the definition of SO(3): RᵀR = I and det R = +1.
 TEST(Exercise1_3, RotationMatrixIsProperOnRandomQuaternions) {
   grbd::test::Random rng(1301);
-  double worst = 0.0;
+  WorstCase worst;
   for (int n = 0; n < kSamples; ++n) {
-    const Matrix3 R = rotation_matrix(rng.unit_quaternion());
-    worst = std::max(worst, max_abs(R.transpose() * R - Matrix3::Identity()));
-    worst = std::max(worst, std::abs(R.determinant() - 1.0));
+    const Quaternion p = rng.unit_quaternion();
+    const Matrix3 R = rotation_matrix(p);
+    worst.update(max_abs(R.transpose() * R - Matrix3::Identity()), n,
+                 [&] { return "RᵀR = I, " + describe("p", p); });
+    worst.update(std::abs(R.determinant() - 1.0), n,
+                 [&] { return "det R = 1, " + describe("p", p); });
   }
-  EXPECT_LE(worst, kTol);
+  EXPECT_LE(worst.value(), kTol) << worst;
 }
 
 // Reference: the definition, R(p) x = vector part of p (0, x) p̄, with the products computed
 // through complex matrices; the scalar part of p (0, x) p̄ vanishes.
 TEST(Exercise1_3, RotationMatrixIsTheSandwichOnPureQuaternions) {
   grbd::test::Random rng(1302);
-  double worst = 0.0;
+  WorstCase worst;
   for (int n = 0; n < kSamples; ++n) {
     const Quaternion p = rng.unit_quaternion();
     const Vector3 x = rng.vector3();
     const Quaternion y =
         reference_product(reference_product(p, Quaternion::pure(x)), p.conjugate());
-    worst = std::max(worst, std::abs(y.p0()));
-    worst = std::max(worst, (rotation_matrix(p) * x - y.p_r()).cwiseAbs().maxCoeff());
+    worst.update(std::abs(y.p0()), n,
+                 [&] { return "scalar part of p (0, x) p̄, " + describe("p", p, "x", x); });
+    worst.update((rotation_matrix(p) * x - y.p_r()).cwiseAbs().maxCoeff(), n,
+                 [&] { return "R(p) x, " + describe("p", p, "x", x); });
   }
-  EXPECT_LE(worst, kTol);
+  EXPECT_LE(worst.value(), kTol) << worst;
 }
 
 // Reference: every term of R(p) is quadratic in p, so R(−p) = R(p), exactly (a negation is
@@ -94,21 +100,22 @@ TEST(Exercise1_3, RotationMatrixIsEven) {
 // through complex matrices.
 TEST(Exercise1_3, RotationMatrixIsAHomomorphism) {
   grbd::test::Random rng(1304);
-  double worst = 0.0;
+  WorstCase worst;
   for (int n = 0; n < kSamples; ++n) {
     const Quaternion p = rng.unit_quaternion();
     const Quaternion q = rng.unit_quaternion();
-    worst = std::max(worst, max_abs(rotation_matrix(reference_product(p, q)) -
-                                    rotation_matrix(p) * rotation_matrix(q)));
+    worst.update(max_abs(rotation_matrix(reference_product(p, q)) -
+                         rotation_matrix(p) * rotation_matrix(q)),
+                 n, [&] { return describe("p", p, "q", q); });
   }
-  EXPECT_LE(worst, kTol);
+  EXPECT_LE(worst.value(), kTol) << worst;
 }
 
 // Reference: the closed forms of the rotations by θ about the coordinate axes, e.g. about z
 // [[cos θ, −sin θ, 0], [sin θ, cos θ, 0], [0, 0, 1]], with p = (cos θ/2, sin θ/2 e).
 TEST(Exercise1_3, RotationAboutCoordinateAxesIsTheClosedForm) {
   grbd::test::Random rng(1305);
-  double worst = 0.0;
+  WorstCase worst;
   for (int n = 0; n < 1000; ++n) {
     const double theta = rng.uniform(-2.0 * pi, 2.0 * pi);
     const double c = std::cos(theta);
@@ -117,41 +124,43 @@ TEST(Exercise1_3, RotationAboutCoordinateAxesIsTheClosedForm) {
     Rx << 1, 0, 0, 0, c, -s, 0, s, c;
     Ry << c, 0, s, 0, 1, 0, -s, 0, c;
     Rz << c, -s, 0, s, c, 0, 0, 0, 1;
-    worst = std::max(worst,
-                     max_abs(rotation_matrix(axis_angle_quaternion(Vector3::UnitX(), theta)) - Rx));
-    worst = std::max(worst,
-                     max_abs(rotation_matrix(axis_angle_quaternion(Vector3::UnitY(), theta)) - Ry));
-    worst = std::max(worst,
-                     max_abs(rotation_matrix(axis_angle_quaternion(Vector3::UnitZ(), theta)) - Rz));
+    worst.update(max_abs(rotation_matrix(axis_angle_quaternion(Vector3::UnitX(), theta)) - Rx), n,
+                 [&] { return describe("axis", "x", "theta", theta); });
+    worst.update(max_abs(rotation_matrix(axis_angle_quaternion(Vector3::UnitY(), theta)) - Ry), n,
+                 [&] { return describe("axis", "y", "theta", theta); });
+    worst.update(max_abs(rotation_matrix(axis_angle_quaternion(Vector3::UnitZ(), theta)) - Rz), n,
+                 [&] { return describe("axis", "z", "theta", theta); });
   }
   // cos²(θ/2) − sin²(θ/2) and 2 sin(θ/2) cos(θ/2) against cos θ and sin θ: a few ulps.
-  EXPECT_LE(worst, kTol);
+  EXPECT_LE(worst.value(), kTol) << worst;
 }
 
 // Reference: the classical axis–angle matrix at random axes and angles.
 TEST(Exercise1_3, RotationMatrixEqualsAxisAngleForm) {
   grbd::test::Random rng(1306);
-  double worst = 0.0;
+  WorstCase worst;
   for (int n = 0; n < kSamples; ++n) {
     const Vector3 axis = rng.unit_vector3();
     const double angle = rng.uniform(-2.0 * pi, 2.0 * pi);
-    worst = std::max(worst, max_abs(rotation_matrix(axis_angle_quaternion(axis, angle)) -
-                                    axis_angle_matrix(axis, angle)));
+    worst.update(max_abs(rotation_matrix(axis_angle_quaternion(axis, angle)) -
+                         axis_angle_matrix(axis, angle)),
+                 n, [&] { return describe("axis", axis, "angle", angle); });
   }
-  EXPECT_LE(worst, kTol);
+  EXPECT_LE(worst.value(), kTol) << worst;
 }
 
 // Reference: homogeneity of degree 2, rotation_matrix(p) = |p|² R(p/|p|) (the scalable body).
 TEST(Exercise1_3, NonUnitQuaternionGivesScaledRotation) {
   grbd::test::Random rng(1307);
-  double worst = 0.0;
+  WorstCase worst;
   for (int n = 0; n < kSamples; ++n) {
     const Quaternion P = rng.quaternion();
     const Quaternion p(grbd::Vector4(P.coeffs() / P.norm()));
-    worst = std::max(worst, max_abs(rotation_matrix(P) - P.squared_norm() * rotation_matrix(p)) /
-                                P.squared_norm());
+    worst.update(
+        max_abs(rotation_matrix(P) - P.squared_norm() * rotation_matrix(p)) / P.squared_norm(), n,
+        [&] { return describe("P", P); });
   }
-  EXPECT_LE(worst, kTol);
+  EXPECT_LE(worst.value(), kTol) << worst;
 }
 
 // ----------------------------------------------------------------------------------------------
@@ -195,11 +204,16 @@ std::vector<Vector3> test_axes(grbd::test::Random& rng, int random_count) {
 // Reference: the known quaternion p(n, φ) = (cos φ/2, sin φ/2 n), up to sign.
 TEST(Exercise1_4, RoundTripAtRandomAngles) {
   grbd::test::Random rng(1401);
-  double worst = 0.0;
+  WorstCase worst;
   for (int n = 0; n < kSamples; ++n) {
-    worst = std::max(worst, round_trip_error(rng.unit_vector3(), rng.uniform(-2.0 * pi, 2.0 * pi)));
+    // The inputs are drawn as the arguments of a call with round_trip_error's signature.
+    const auto check = [&](const Vector3& axis, double angle) {
+      worst.update(round_trip_error(axis, angle), n,
+                   [&] { return describe("axis", axis, "angle", angle); });
+    };
+    check(rng.unit_vector3(), rng.uniform(-2.0 * pi, 2.0 * pi));
   }
-  EXPECT_LE(worst, kTol);
+  EXPECT_LE(worst.value(), kTol) << worst;
 }
 
 // Reference: p(n, φ) for φ → 0. Near the identity the vector part is small; it must also be
@@ -207,35 +221,38 @@ TEST(Exercise1_4, RoundTripAtRandomAngles) {
 // of 1 − p0² (≈ 0) could not achieve.
 TEST(Exercise1_4, RoundTripNearZeroAngle) {
   grbd::test::Random rng(1402);
-  double worst = 0.0;
-  double worst_relative = 0.0;
+  WorstCase worst;
+  WorstCase worst_relative;
   for (const Vector3& n : test_axes(rng, 300)) {
     for (double angle : {0.0, 1e-15, 1e-12, 1e-9, 1e-6, 1e-3, -1e-9, -1e-3}) {
-      worst = std::max(worst, round_trip_error(n, angle));
+      worst.update(round_trip_error(n, angle), [&] { return describe("axis", n, "angle", angle); });
       if (angle != 0.0) {
         const Quaternion p = axis_angle_quaternion(n, angle);
         const Quaternion found = quaternion_from_rotation_matrix(axis_angle_matrix(n, angle));
-        worst_relative = std::max(worst_relative, (found.p_r() - p.p_r()).norm() / p.p_r().norm());
+        worst_relative.update((found.p_r() - p.p_r()).norm() / p.p_r().norm(), [&] {
+          return describe("axis", n, "angle", angle, "p", p, "found", found);
+        });
       }
     }
   }
-  EXPECT_LE(worst, kTol);
-  EXPECT_LE(worst_relative, kTol);
+  EXPECT_LE(worst.value(), kTol) << worst;
+  EXPECT_LE(worst_relative.value(), kTol) << worst_relative;
 }
 
 // Reference: p(n, φ) for φ → π from both sides (φ > π has p0 < 0, so −p must be returned) and
 // at φ = π exactly, where R − Rᵀ ≈ 0 and only the diagonal determines the axis.
 TEST(Exercise1_4, RoundTripNearAndAtPi) {
   grbd::test::Random rng(1403);
-  double worst = 0.0;
+  WorstCase worst;
   for (const Vector3& n : test_axes(rng, 1000)) {
     for (double delta : {0.0, 1e-15, 1e-12, 1e-9, 1e-6, 1e-3}) {
-      worst = std::max(worst, round_trip_error(n, pi - delta));
-      worst = std::max(worst, round_trip_error(n, pi + delta));
-      worst = std::max(worst, round_trip_error(n, -pi + delta));
+      for (const double angle : {pi - delta, pi + delta, -pi + delta}) {
+        worst.update(round_trip_error(n, angle),
+                     [&] { return describe("axis", n, "angle", angle, "delta", delta); });
+      }
     }
   }
-  EXPECT_LE(worst, kTol);
+  EXPECT_LE(worst.value(), kTol) << worst;
 }
 
 // Reference: the closed-form rotation by π about each coordinate axis, diag(1, −1, −1) etc.,
@@ -262,14 +279,15 @@ TEST(Exercise1_4, HalfTurnsAboutCoordinateAxes) {
 // Reference: P x P⁻¹ = R(P/|P|) x for any P ≠ 0 (the scale cancels).
 TEST(Sandwich, EqualsRotationMatrixOfTheNormalizedQuaternion) {
   grbd::test::Random rng(1501);
-  double worst = 0.0;
+  WorstCase worst;
   for (int n = 0; n < kSamples; ++n) {
     const Quaternion P = rng.quaternion();
     const Vector3 x = rng.vector3();
     const Vector3 expected = rotation_matrix(P.normalized()) * x;
-    worst = std::max(worst, (grbd::kinematics::sandwich(P, x) - expected).cwiseAbs().maxCoeff());
+    worst.update((grbd::kinematics::sandwich(P, x) - expected).cwiseAbs().maxCoeff(), n,
+                 [&] { return describe("P", P, "x", x); });
   }
-  EXPECT_LE(worst, kTol);
+  EXPECT_LE(worst.value(), kTol) << worst;
 }
 
 // Reference: a rotation keeps lengths and cross products (orientation): |Px P⁻¹| = |x| and
@@ -277,17 +295,18 @@ TEST(Sandwich, EqualsRotationMatrixOfTheNormalizedQuaternion) {
 TEST(Sandwich, KeepsLengthsAndCrossProducts) {
   using grbd::kinematics::sandwich;
   grbd::test::Random rng(1502);
-  double worst = 0.0;
+  WorstCase worst;
   for (int n = 0; n < kSamples; ++n) {
     const Quaternion P = rng.quaternion();
     const Vector3 x = rng.vector3();
     const Vector3 y = rng.vector3();
-    worst = std::max(worst, std::abs(sandwich(P, x).norm() - x.norm()));
-    worst = std::max(
-        worst,
-        (sandwich(P, x.cross(y)) - sandwich(P, x).cross(sandwich(P, y))).cwiseAbs().maxCoeff());
+    worst.update(std::abs(sandwich(P, x).norm() - x.norm()), n,
+                 [&] { return "|P x P⁻¹| = |x|, " + describe("P", P, "x", x); });
+    worst.update(
+        (sandwich(P, x.cross(y)) - sandwich(P, x).cross(sandwich(P, y))).cwiseAbs().maxCoeff(), n,
+        [&] { return "cross products, " + describe("P", P, "x", x, "y", y); });
   }
-  EXPECT_LE(worst, kTol);
+  EXPECT_LE(worst.value(), kTol) << worst;
 }
 
 // Reference: the documented precondition P ≠ 0.
@@ -299,7 +318,7 @@ TEST(Sandwich, ZeroQuaternionThrows) {
 // Reference: ξ = s R ρ + r with P = √s p(n, φ) and R the axis–angle matrix of (n, φ).
 TEST(BodyMotion, IsTheScalableBodyMotion) {
   grbd::test::Random rng(1601);
-  double worst = 0.0;
+  WorstCase worst;
   for (int n = 0; n < kSamples; ++n) {
     const Vector3 axis = rng.unit_vector3();
     const double angle = rng.uniform(-pi, pi);
@@ -308,18 +327,18 @@ TEST(BodyMotion, IsTheScalableBodyMotion) {
     const Vector3 r = rng.vector3();
     const Vector3 rho = rng.vector3();
     const Vector3 expected = s * axis_angle_matrix(axis, angle) * rho + r;
-    worst = std::max(
-        worst,
-        (grbd::kinematics::body_motion(P, r, rho) - expected).cwiseAbs().maxCoeff() / (1.0 + s));
+    worst.update(
+        (grbd::kinematics::body_motion(P, r, rho) - expected).cwiseAbs().maxCoeff() / (1.0 + s), n,
+        [&] { return describe("axis", axis, "angle", angle, "s", s, "r", r, "rho", rho); });
   }
-  EXPECT_LE(worst, kTol);
+  EXPECT_LE(worst.value(), kTol) << worst;
 }
 
 // Reference: a scalable body motion multiplies all distances by s = |P|²; for unit P it is rigid.
 TEST(BodyMotion, ScalesDistancesByTheSquaredNorm) {
   using grbd::kinematics::body_motion;
   grbd::test::Random rng(1602);
-  double worst = 0.0;
+  WorstCase worst;
   for (int n = 0; n < kSamples; ++n) {
     const Quaternion P = n % 2 == 0 ? rng.quaternion() : rng.unit_quaternion();
     const Vector3 r = rng.vector3();
@@ -327,9 +346,10 @@ TEST(BodyMotion, ScalesDistancesByTheSquaredNorm) {
     const Vector3 b = rng.vector3();
     const double s = P.squared_norm();
     const double d = (body_motion(P, r, a) - body_motion(P, r, b)).norm();
-    worst = std::max(worst, std::abs(d - s * (a - b).norm()) / (1.0 + s));
+    worst.update(std::abs(d - s * (a - b).norm()) / (1.0 + s), n,
+                 [&] { return describe("P", P, "r", r, "a", a, "b", b); });
   }
-  EXPECT_LE(worst, kTol);
+  EXPECT_LE(worst.value(), kTol) << worst;
 }
 
 // Reference: the written-out quaternion (cos φ/2, sin φ/2 n) and the principal range φ ∈ [0, π].
@@ -337,23 +357,26 @@ TEST(AxisAngle, RoundTripAndPrincipalRange) {
   using grbd::kinematics::axis_angle;
   using grbd::kinematics::quaternion_from_axis_angle;
   grbd::test::Random rng(1701);
-  double worst = 0.0;
+  WorstCase worst;
   for (int n = 0; n < kSamples; ++n) {
     const Vector3 axis = rng.unit_vector3();
     const double scale = rng.uniform(0.1, 10.0);
     const double angle = rng.uniform(0.01, 2.0 * pi - 0.01);
     const Quaternion p = quaternion_from_axis_angle(scale * axis, angle);
-    worst = std::max(
-        worst, (p.coeffs() - axis_angle_quaternion(axis, angle).coeffs()).cwiseAbs().maxCoeff());
+    const auto inputs = [&] { return describe("axis", axis, "scale", scale, "angle", angle); };
+    worst.update((p.coeffs() - axis_angle_quaternion(axis, angle).coeffs()).cwiseAbs().maxCoeff(),
+                 n, [&] { return "quaternion_from_axis_angle, " + inputs(); });
     const auto [found_axis, found_angle] = axis_angle(p);
     // Angles above π are the rotation by 2π − φ about −n.
     const bool flipped = angle > pi;
-    worst = std::max(worst, std::abs(found_angle - (flipped ? 2.0 * pi - angle : angle)));
-    worst = std::max(worst, (found_axis - (flipped ? -axis : axis)).cwiseAbs().maxCoeff());
+    worst.update(std::abs(found_angle - (flipped ? 2.0 * pi - angle : angle)), n,
+                 [&] { return "angle of axis_angle(p), " + inputs(); });
+    worst.update((found_axis - (flipped ? -axis : axis)).cwiseAbs().maxCoeff(), n,
+                 [&] { return "axis of axis_angle(p), " + inputs(); });
     ASSERT_GE(found_angle, 0.0);
     ASSERT_LE(found_angle, pi);
   }
-  EXPECT_LE(worst, kTol);
+  EXPECT_LE(worst.value(), kTol) << worst;
 }
 
 // Reference: the documented conventions (φ = 0 gives e_x; ±1 are the identity) and

@@ -28,6 +28,7 @@
 #include "grbd_test/bodies.hpp"
 #include "grbd_test/random.hpp"
 #include "grbd_test/references.hpp"
+#include "grbd_test/worst_case.hpp"
 
 namespace {
 
@@ -44,6 +45,7 @@ using grbd::kinematics::make_q;
 using grbd::kinematics::make_u;
 using grbd::kinematics::Quaternion;
 using grbd::test::axis_angle_matrix;
+using grbd::test::describe;
 using grbd::test::exact_motion;
 using grbd::test::max_abs;
 using grbd::test::random_body;
@@ -51,6 +53,7 @@ using grbd::test::random_loads;
 using grbd::test::random_state;
 using grbd::test::reference_A_IK;
 using grbd::test::SymmetricTop;
+using grbd::test::WorstCase;
 
 constexpr double kEps = std::numeric_limits<double>::epsilon();
 
@@ -121,22 +124,25 @@ void expect_discrete_free_fall(StepFunction step, double c) {
   constexpr int N = 1000;
   const double h = 1e-3;
   State x{make_q(r0, p0), make_u(v0, Vector3::Zero())};
-  double worst_r = 0.0;
-  double worst_v = 0.0;
-  double worst_p = 0.0;
+  WorstCase worst_r;
+  WorstCase worst_v;
+  WorstCase worst_p;
   for (int n = 1; n <= N; ++n) {
     x = step(body, x, gravity, h);
     const double t = n * h;
     const Vector3 r = r0 + v0 * t + 0.5 * g * t * t + c * h * g * t;
     const Vector3 v = v0 + g * t;
     const double tol = 2.0 * n * kEps * (1.0 + r.norm() + t * v.norm());
-    worst_r = std::max(worst_r, max_abs(x.q.head<3>() - r) / tol);
-    worst_v = std::max(worst_v, max_abs(x.u.head<3>() - v) / tol);
-    worst_p = std::max(worst_p, max_abs(x.q.tail<4>() - p0.coeffs()));
+    const auto inputs = [&] {
+      return describe("c", c, "step", n, "t", t, "x_n", x, "r exact", r, "v exact", v);
+    };
+    worst_r.update(max_abs(x.q.head<3>() - r) / tol, inputs);
+    worst_v.update(max_abs(x.u.head<3>() - v) / tol, inputs);
+    worst_p.update(max_abs(x.q.tail<4>() - p0.coeffs()), inputs);
   }
-  EXPECT_LE(worst_r, 1.0) << "position error / tolerance";
-  EXPECT_LE(worst_v, 1.0) << "velocity error / tolerance";
-  EXPECT_LE(worst_p, 2.0 * kEps) << "a body with ω = 0 does not turn";
+  EXPECT_LE(worst_r.value(), 1.0) << "position error / tolerance; " << worst_r;
+  EXPECT_LE(worst_v.value(), 1.0) << "velocity error / tolerance; " << worst_v;
+  EXPECT_LE(worst_p.value(), 2.0 * kEps) << "a body with ω = 0 does not turn; " << worst_p;
 }
 
 /// The isotropic harmonic oscillator F = −k r on a body that does not turn: m = 2, k = 50
@@ -159,8 +165,8 @@ struct Oscillator {
 /// differences lose a few ulps of E and |L|²: tolerances 8 eps E and 8 eps |L|².
 void expect_exact_explicit_euler_drift(StepFunction step) {
   grbd::test::Random rng(2555);
-  double worst_E = 0.0;
-  double worst_L = 0.0;
+  WorstCase worst_E;
+  WorstCase worst_L;
   for (double h : {1e-3, 1e-2, 1e-1}) {
     for (int n = 0; n < 2000; ++n) {
       const RigidBody body = random_body(rng);
@@ -171,15 +177,16 @@ void expect_exact_explicit_euler_drift(StepFunction step) {
       const double E = grbd::body::kinetic_energy(body, x.u);
       const double dE = grbd::body::kinetic_energy(body, y.u) - E;
       const double dE_exact = 0.5 * h * h * w_dot.dot(body.K_Theta.cwiseProduct(w_dot));
-      worst_E = std::max(worst_E, std::abs(dE - dE_exact) / (kEps * E));
+      const auto inputs = [&] { return describe("h", h, "body", body, "x", x); };
+      worst_E.update(std::abs(dE - dE_exact) / (kEps * E), n, inputs);
       const Vector3 L = K_L(body, x);
       const double dL2 = K_L(body, y).squaredNorm() - L.squaredNorm();
       const double dL2_exact = h * h * L.cross(w).squaredNorm();
-      worst_L = std::max(worst_L, std::abs(dL2 - dL2_exact) / (kEps * L.squaredNorm()));
+      worst_L.update(std::abs(dL2 - dL2_exact) / (kEps * L.squaredNorm()), n, inputs);
     }
   }
-  EXPECT_LE(worst_E, 8.0) << "|ΔE − h²/2 ω̇ᵀΘω̇| in units of eps E";
-  EXPECT_LE(worst_L, 8.0) << "|Δ|L|² − h²|L × ω|²| in units of eps |L|²";
+  EXPECT_LE(worst_E.value(), 8.0) << "|ΔE − h²/2 ω̇ᵀΘω̇| in units of eps E; " << worst_E;
+  EXPECT_LE(worst_L.value(), 8.0) << "|Δ|L|² − h²|L × ω|²| in units of eps |L|²; " << worst_L;
 }
 
 }  // namespace
@@ -199,7 +206,7 @@ TEST(Exercise2_5, EnergyAndMomentumGrowByTheExactExplicitEulerAmounts) {
 // random loads, written out by hand. Tolerance 8 eps T + 8 eps h |uᵀh| (one rounding each).
 TEST(Exercise2_5, EnergyChangeWithLoadsIsTheExactExplicitEulerAmount) {
   grbd::test::Random rng(2501);
-  double worst = 0.0;
+  WorstCase worst;
   for (double h : {1e-3, 1e-2, 1e-1}) {
     for (int n = 0; n < 2000; ++n) {
       const RigidBody body = random_body(rng);
@@ -216,10 +223,12 @@ TEST(Exercise2_5, EnergyChangeWithLoadsIsTheExactExplicitEulerAmount) {
       const double E = grbd::body::kinetic_energy(body, x.u);
       const double dE = grbd::body::kinetic_energy(body, y.u) - E;
       const double tol = 8.0 * kEps * (E + h * std::abs(power) + h * h * second);
-      worst = std::max(worst, std::abs(dE - (h * power + 0.5 * h * h * second)) / tol);
+      worst.update(std::abs(dE - (h * power + 0.5 * h * h * second)) / tol, n, [&] {
+        return describe("h", h, "body", body, "x", x, "loads", loads);
+      });
     }
   }
-  EXPECT_LE(worst, 1.0) << "error / tolerance";
+  EXPECT_LE(worst.value(), 1.0) << "error / tolerance; " << worst;
 }
 
 // Reference: q⁺ is the exact motion with the velocities at the start of the step,
@@ -227,16 +236,17 @@ TEST(Exercise2_5, EnergyChangeWithLoadsIsTheExactExplicitEulerAmount) {
 // grbd_test/references.hpp. Entries O(1): tolerance 1e-15 (a few roundings).
 TEST(Exercise2_5, PositionAndOrientationMoveWithTheOldVelocities) {
   grbd::test::Random rng(2502);
-  double worst = 0.0;
+  WorstCase worst;
   for (int n = 0; n < 10000; ++n) {
     const RigidBody body = random_body(rng);
     const State x = random_state(rng);
     const Loads loads = random_loads(rng);
     const double h = rng.uniform(0.0, 0.1);
     const State y = grbd::body::explicit_exp_map_step(body, x, loads, h);
-    worst = std::max(worst, max_abs(y.q - exact_motion(x.q, x.u, h)));
+    worst.update(max_abs(y.q - exact_motion(x.q, x.u, h)), n,
+                 [&] { return describe("body", body, "x", x, "loads", loads, "h", h); });
   }
-  EXPECT_LE(worst, 1e-15);
+  EXPECT_LE(worst.value(), 1e-15) << worst;
 }
 
 // Reference: the lecture's claim that the exponential map keeps |p| = 1 with no projection. On a
@@ -297,13 +307,14 @@ TEST(Exercise2_5, HarmonicOscillatorGainsTheExactFactorEachStep) {
   const auto energy = [&](const State& s) {
     return s.u.head<3>().squaredNorm() + w2 * s.q.head<3>().squaredNorm();
   };
-  double worst = 0.0;
+  WorstCase worst;
   for (int n = 0; n < 200; ++n) {
     const State y = grbd::body::explicit_exp_map_step(oscillator.body, x, oscillator.spring(x), h);
-    worst = std::max(worst, std::abs(energy(y) / energy(x) / (1.0 + h * h * w2) - 1.0));
+    worst.update(std::abs(energy(y) / energy(x) / (1.0 + h * h * w2) - 1.0),
+                 [&] { return describe("step", n, "x_n", x, "x_{n+1}", y); });
     x = y;
   }
-  EXPECT_LE(worst, 1e-14);
+  EXPECT_LE(worst.value(), 1e-14) << worst;
 }
 
 // ----------------------------------------------------------------------------------------------
@@ -316,7 +327,7 @@ TEST(Exercise2_5, HarmonicOscillatorGainsTheExactFactorEachStep) {
 // 1e-14 on p and 1e-14 (1 + |ω⁺|_max) on ω.
 TEST(Exercise2_6, IsTheRotationAboutThePrincipalAxis) {
   grbd::test::Random rng(2601);
-  double worst = 0.0;
+  WorstCase worst;
   for (int n = 0; n < 10000; ++n) {
     const RigidBody body = random_body(rng);
     const State x = random_state(rng);
@@ -330,12 +341,14 @@ TEST(Exercise2_6, IsTheRotationAboutThePrincipalAxis) {
     const Vector3 L_plus = Eigen::AngleAxisd(-phi, Vector3::Unit(axis)) * K_L(body, x);
     ASSERT_EQ(Vector3(y.q.head<3>()), Vector3(x.q.head<3>()));
     ASSERT_EQ(Vector3(y.u.head<3>()), Vector3(x.u.head<3>()));
-    worst = std::max(
-        worst, max_abs(y.q.tail<4>() - Vector4(p_plus.w(), p_plus.x(), p_plus.y(), p_plus.z())));
-    worst = std::max(worst, max_abs(y.u.tail<3>() - L_plus.cwiseQuotient(body.K_Theta)) /
-                                (1.0 + max_abs(y.u.tail<3>())));
+    const auto inputs = [&] { return describe("body", body, "x", x, "axis", axis, "t", t); };
+    worst.update(max_abs(y.q.tail<4>() - Vector4(p_plus.w(), p_plus.x(), p_plus.y(), p_plus.z())),
+                 n, [&] { return "p⁺, " + inputs(); });
+    worst.update(max_abs(y.u.tail<3>() - L_plus.cwiseQuotient(body.K_Theta)) /
+                     (1.0 + max_abs(y.u.tail<3>())),
+                 n, [&] { return "ω⁺, " + inputs(); });
   }
-  EXPECT_LE(worst, 1e-14);
+  EXPECT_LE(worst.value(), 1e-14) << worst;
 }
 
 // Reference: the Hamiltonian flow of T_i = L_i²/(2Θ_i) solves the Euler–Poisson equations
@@ -344,7 +357,7 @@ TEST(Exercise2_6, IsTheRotationAboutThePrincipalAxis) {
 TEST(Exercise2_6, SolvesTheEquationsOfMotionOfOneAxis) {
   grbd::test::Random rng(2602);
   constexpr double delta = 1e-5;
-  double worst = 0.0;
+  WorstCase worst;
   for (int n = 0; n < 3000; ++n) {
     const RigidBody body = random_body(rng);
     const State x = random_state(rng);
@@ -353,14 +366,16 @@ TEST(Exercise2_6, SolvesTheEquationsOfMotionOfOneAxis) {
     const State minus = grbd::body::free_rotation_about_axis(body, x, axis, -delta);
     const Vector3 L_dot = (K_L(body, plus) - K_L(body, minus)) / (2.0 * delta);
     const Vector3 omega_i = x.u[3 + axis] * Vector3::Unit(axis);
-    worst = std::max(worst, max_abs(L_dot - K_L(body, x).cross(omega_i)));
+    const auto inputs = [&] { return describe("body", body, "x", x, "axis", axis); };
+    worst.update(max_abs(L_dot - K_L(body, x).cross(omega_i)), n,
+                 [&] { return "K_L̇, " + inputs(); });
     const Vector4 p_dot = (plus.q.tail<4>() - minus.q.tail<4>()) / (2.0 * delta);
     const Quaternion expected =
         0.5 * grbd::test::reference_product(Quaternion(Vector4(x.q.tail<4>())),
                                             Quaternion::pure(omega_i));
-    worst = std::max(worst, max_abs(p_dot - expected.coeffs()));
+    worst.update(max_abs(p_dot - expected.coeffs()), n, [&] { return "ṗ, " + inputs(); });
   }
-  EXPECT_LE(worst, 1e-8);
+  EXPECT_LE(worst.value(), 1e-8) << worst;
 }
 
 // Reference: the invariants of the flow of T_i: ω_i (hence L_i and T_i) exactly; |K_L| and
@@ -368,19 +383,23 @@ TEST(Exercise2_6, SolvesTheEquationsOfMotionOfOneAxis) {
 // (The rest of the energy, T_j + T_k, changes unless Θ_j = Θ_k: it is the other pieces' job.)
 TEST(Exercise2_6, KeepsLiTheNormOfLAndTheWorldAngularMomentum) {
   grbd::test::Random rng(2603);
-  double worst = 0.0;
+  WorstCase worst;
   for (int n = 0; n < 10000; ++n) {
     const RigidBody body = random_body(rng);
     const State x = random_state(rng);
     const int axis = n % 3;
-    const State y = grbd::body::free_rotation_about_axis(body, x, axis, rng.uniform(-5.0, 5.0));
+    const double t = rng.uniform(-5.0, 5.0);
+    const State y = grbd::body::free_rotation_about_axis(body, x, axis, t);
     ASSERT_EQ(y.u[3 + axis], x.u[3 + axis]);
     const Vector3 L = K_L(body, x);
     const Vector3 I_L = reference_A_IK(x.q) * L;
-    worst = std::max(worst, std::abs(K_L(body, y).norm() - L.norm()) / L.norm());
-    worst = std::max(worst, (reference_A_IK(y.q) * K_L(body, y) - I_L).norm() / L.norm());
+    const auto inputs = [&] { return describe("body", body, "x", x, "axis", axis, "t", t); };
+    worst.update(std::abs(K_L(body, y).norm() - L.norm()) / L.norm(), n,
+                 [&] { return "|K_L|, " + inputs(); });
+    worst.update((reference_A_IK(y.q) * K_L(body, y) - I_L).norm() / L.norm(), n,
+                 [&] { return "I_L, " + inputs(); });
   }
-  EXPECT_LE(worst, 1e-14);
+  EXPECT_LE(worst.value(), 1e-14) << worst;
 }
 
 // Reference: a flow is a one-parameter group: Φ_s ∘ Φ_t = Φ_{s+t} and Φ_{−t} ∘ Φ_t = id, to
@@ -389,7 +408,7 @@ TEST(Exercise2_6, KeepsLiTheNormOfLAndTheWorldAngularMomentum) {
 // 1e-14 (1 + |u|_max).
 TEST(Exercise2_6, IsAOneParameterGroup) {
   grbd::test::Random rng(2604);
-  double worst = 0.0;
+  WorstCase worst;
   for (int n = 0; n < 10000; ++n) {
     const RigidBody body = random_body(rng);
     const State x = random_state(rng);
@@ -403,10 +422,16 @@ TEST(Exercise2_6, IsAOneParameterGroup) {
     const State back =
         free_rotation_about_axis(body, free_rotation_about_axis(body, x, axis, t), axis, -t);
     const double scale = 1.0 + std::max(max_abs(direct.u), max_abs(x.u));
-    worst = std::max({worst, max_abs(composed.q - direct.q), max_abs(composed.u - direct.u) / scale,
-                      max_abs(back.q - x.q), max_abs(back.u - x.u) / scale});
+    const auto inputs = [&] {
+      return describe("body", body, "x", x, "axis", axis, "s", s, "t", t);
+    };
+    worst.update(max_abs(composed.q - direct.q), n, [&] { return "Φ_s∘Φ_t q, " + inputs(); });
+    worst.update(max_abs(composed.u - direct.u) / scale, n,
+                 [&] { return "Φ_s∘Φ_t u, " + inputs(); });
+    worst.update(max_abs(back.q - x.q), n, [&] { return "Φ_−t∘Φ_t q, " + inputs(); });
+    worst.update(max_abs(back.u - x.u) / scale, n, [&] { return "Φ_−t∘Φ_t u, " + inputs(); });
   }
-  EXPECT_LE(worst, 1e-14);
+  EXPECT_LE(worst.value(), 1e-14) << worst;
 }
 
 // ----------------------------------------------------------------------------------------------
@@ -549,7 +574,7 @@ TEST(FreeFall, EachSchemeFollowsItsDiscreteParabola) {
 // Entries O(1): tolerance 1e-14.
 TEST(SymplecticExpMap, VelocitiesFirstThenTheExactMotionWithThem) {
   grbd::test::Random rng(2801);
-  double worst = 0.0;
+  WorstCase worst;
   for (int n = 0; n < 10000; ++n) {
     const RigidBody body = random_body(rng);
     const State x = random_state(rng);
@@ -559,10 +584,15 @@ TEST(SymplecticExpMap, VelocitiesFirstThenTheExactMotionWithThem) {
     const Vector3 v = x.u.head<3>() + h * loads.I_F / body.m;
     const Vector3 w = x.u.tail<3>() + h * (torque_free_omega_dot(body, x.u.tail<3>()) +
                                            loads.K_M.cwiseQuotient(body.K_Theta));
-    worst = std::max({worst, max_abs(y.u.head<3>() - v), max_abs(y.u.tail<3>() - w),
-                      max_abs(y.q - exact_motion(x.q, make_u(v, w), h))});
+    const auto inputs = [&] {
+      return describe("body", body, "x", x, "loads", loads, "h", h);
+    };
+    worst.update(max_abs(y.u.head<3>() - v), n, [&] { return "v⁺, " + inputs(); });
+    worst.update(max_abs(y.u.tail<3>() - w), n, [&] { return "ω⁺, " + inputs(); });
+    worst.update(max_abs(y.q - exact_motion(x.q, make_u(v, w), h)), n,
+                 [&] { return "q⁺, " + inputs(); });
   }
-  EXPECT_LE(worst, 1e-14);
+  EXPECT_LE(worst.value(), 1e-14) << worst;
 }
 
 // Reference: the exact one-step identities of explicit Euler (tolerances in
@@ -588,12 +618,12 @@ TEST(SymplecticExpMap, HarmonicOscillatorKeepsTheModifiedEnergy) {
     return v.squaredNorm() + w2 * r.squaredNorm() - h * w2 * r.dot(v);
   };
   const double Q0 = Q(x);
-  double worst = 0.0;
+  WorstCase worst;
   for (int n = 0; n < 10000; ++n) {
     x = grbd::body::symplectic_exp_map_step(oscillator.body, x, oscillator.spring(x), h);
-    worst = std::max(worst, std::abs(Q(x) / Q0 - 1.0));
+    worst.update(std::abs(Q(x) / Q0 - 1.0), [&] { return describe("step", n, "x_{n+1}", x); });
   }
-  EXPECT_LE(worst, 1e-12);
+  EXPECT_LE(worst.value(), 1e-12) << worst;
 }
 
 // Reference: the closed-form symmetric top; observed order in [0.85, 1.15].
@@ -610,8 +640,8 @@ TEST(SymplecticExpMap, ConvergesAtFirstOrderOnTheSymmetricTop) {
 // Tolerance 1e-15; |p⁺| = 1 to 4 eps (the norm divided by is rounded, and so is the one checked).
 TEST(ExplicitEulerNormalized, TurnsByTheArcTangentAndStaysUnit) {
   grbd::test::Random rng(2901);
-  double worst = 0.0;
-  double worst_norm = 0.0;
+  WorstCase worst;
+  WorstCase worst_norm;
   for (int n = 0; n < 10000; ++n) {
     const RigidBody body = random_body(rng);
     const State x = random_state(rng);
@@ -621,12 +651,14 @@ TEST(ExplicitEulerNormalized, TurnsByTheArcTangentAndStaysUnit) {
     const Quaternion p = grbd::test::reference_product(
         Quaternion(Vector4(x.q.tail<4>())),
         grbd::test::closed_form_exp(w.normalized(), std::atan(0.5 * h * w.norm())));
-    worst = std::max({worst, max_abs(y.q.tail<4>() - p.coeffs()),
-                      max_abs(y.q.head<3>() - (x.q.head<3>() + h * x.u.head<3>()))});
-    worst_norm = std::max(worst_norm, std::abs(y.q.tail<4>().norm() - 1.0));
+    const auto inputs = [&] { return describe("body", body, "x", x, "h", h); };
+    worst.update(max_abs(y.q.tail<4>() - p.coeffs()), n, [&] { return "p⁺, " + inputs(); });
+    worst.update(max_abs(y.q.head<3>() - (x.q.head<3>() + h * x.u.head<3>())), n,
+                 [&] { return "r⁺, " + inputs(); });
+    worst_norm.update(std::abs(y.q.tail<4>().norm() - 1.0), n, inputs);
   }
-  EXPECT_LE(worst, 1e-15);
-  EXPECT_LE(worst_norm, 4.0 * kEps);
+  EXPECT_LE(worst.value(), 1e-15) << worst;
+  EXPECT_LE(worst_norm.value(), 4.0 * kEps) << worst_norm;
 }
 
 // Reference: the exact one-step identities of explicit Euler; the velocity update of (c) is that
@@ -662,15 +694,16 @@ TEST(LiePoisson, KeepsTheWorldAngularMomentumAndItsNorm) {
   const RigidBody& body = tumbling.body;
   State x = tumbling.initial;
   const Vector3 I_L0 = reference_A_IK(x.q) * K_L(body, x);
-  double worst_I_L = 0.0;
-  double worst_norm = 0.0;
+  WorstCase worst_I_L;
+  WorstCase worst_norm;
   for (int n = 0; n < 100000; ++n) {
     x = grbd::body::lie_poisson_step(body, x, Loads{}, 0.01);
-    worst_I_L = std::max(worst_I_L, (reference_A_IK(x.q) * K_L(body, x) - I_L0).norm());
-    worst_norm = std::max(worst_norm, std::abs(K_L(body, x).norm() - I_L0.norm()));
+    const auto inputs = [&] { return describe("step", n, "x_{n+1}", x); };
+    worst_I_L.update((reference_A_IK(x.q) * K_L(body, x) - I_L0).norm(), inputs);
+    worst_norm.update(std::abs(K_L(body, x).norm() - I_L0.norm()), inputs);
   }
-  EXPECT_LE(worst_I_L / I_L0.norm(), 1e-12);
-  EXPECT_LE(worst_norm / I_L0.norm(), 1e-12);
+  EXPECT_LE(worst_I_L.value() / I_L0.norm(), 1e-12) << worst_I_L;
+  EXPECT_LE(worst_norm.value() / I_L0.norm(), 1e-12) << worst_norm;
   EXPECT_LE(std::abs(x.q.tail<4>().norm() - 1.0), 1e-12);
 }
 
@@ -687,22 +720,25 @@ TEST(LiePoisson, EnergyErrorIsBoundedWithoutDriftWhileTheExplicitSchemeDrifts) {
   const auto max_energy_errors = [&](double h) {
     const int N = static_cast<int>(std::lround(1000.0 / h));
     State x = tumbling.initial;
-    std::pair<double, double> halves{0.0, 0.0};
+    std::pair<WorstCase, WorstCase> halves;
     for (int n = 0; n < N; ++n) {
       x = grbd::body::lie_poisson_step(body, x, Loads{}, h);
       const double e = std::abs(grbd::body::kinetic_energy(body, x.u) - E0) / E0;
-      double& half = n < N / 2 ? halves.first : halves.second;
-      half = std::max(half, e);
+      WorstCase& half = n < N / 2 ? halves.first : halves.second;
+      half.update(e, [&] { return describe("h", h, "step", n, "x_{n+1}", x); });
     }
     return halves;
   };
   const auto coarse = max_energy_errors(0.05);
   const auto fine = max_energy_errors(0.025);
-  EXPECT_LE(coarse.second, 1.05 * coarse.first)
-      << "drift: " << coarse.first << " → " << coarse.second;
-  EXPECT_LE(fine.second, 1.05 * fine.first) << "drift: " << fine.first << " → " << fine.second;
-  const double order =
-      std::log2(std::max(coarse.first, coarse.second) / std::max(fine.first, fine.second));
+  EXPECT_LE(coarse.second.value(), 1.05 * coarse.first.value())
+      << "drift: " << coarse.first.value() << " → " << coarse.second.value() << "; first half "
+      << coarse.first << "; second half " << coarse.second;
+  EXPECT_LE(fine.second.value(), 1.05 * fine.first.value())
+      << "drift: " << fine.first.value() << " → " << fine.second.value() << "; first half "
+      << fine.first << "; second half " << fine.second;
+  const double order = std::log2(std::max(coarse.first.value(), coarse.second.value()) /
+                                 std::max(fine.first.value(), fine.second.value()));
   EXPECT_GE(order, 1.85);
   EXPECT_LE(order, 2.15);
 
@@ -714,7 +750,7 @@ TEST(LiePoisson, EnergyErrorIsBoundedWithoutDriftWhileTheExplicitSchemeDrifts) {
     ASSERT_GE(E_next, E) << "explicit Euler never loses energy, step " << n;
     E = E_next;
   }
-  EXPECT_GE((E - E0) / E0, 1000.0 * std::max(coarse.first, coarse.second));
+  EXPECT_GE((E - E0) / E0, 1000.0 * std::max(coarse.first.value(), coarse.second.value()));
 }
 
 // Reference: the closed-form symmetric top; the symmetric splitting is of order 2: observed
@@ -729,7 +765,7 @@ TEST(LiePoisson, ConvergesAtSecondOrderOnTheSymmetricTop) {
 // (ω_j reaches ~30 |ω| inside the step): tolerance 2e-14 (1 + |u|_max) (observed 5e-15).
 TEST(LiePoisson, IsTimeReversible) {
   grbd::test::Random rng(3001);
-  double worst = 0.0;
+  WorstCase worst;
   for (int n = 0; n < 10000; ++n) {
     const RigidBody body = random_body(rng);
     const State x = random_state(rng);
@@ -739,9 +775,13 @@ TEST(LiePoisson, IsTimeReversible) {
     y.u = -y.u;
     const State back = grbd::body::lie_poisson_step(body, y, loads, h);
     const double scale = 1.0 + max_abs(x.u) + max_abs(y.u);
-    worst = std::max({worst, max_abs(back.q - x.q) / scale, max_abs(back.u + x.u) / scale});
+    const auto inputs = [&] {
+      return describe("body", body, "x", x, "loads", loads, "h", h);
+    };
+    worst.update(max_abs(back.q - x.q) / scale, n, [&] { return "q, " + inputs(); });
+    worst.update(max_abs(back.u + x.u) / scale, n, [&] { return "u, " + inputs(); });
   }
-  EXPECT_LE(worst, 2e-14);
+  EXPECT_LE(worst.value(), 2e-14) << worst;
 }
 
 // Reference: REFERENCES.md, torque-free symmetric top: in space the symmetry axis a = A e₃
@@ -761,7 +801,7 @@ TEST(LiePoisson, SymmetryAxisOfATopPrecessesAboutLAtLOverIPerp) {
   };
   Vector3 previous = transverse(x).first;
   double swept = 0.0;
-  double worst_cone = 0.0;
+  WorstCase worst_cone;
   const double h = 1e-3;
   constexpr int N = 5000;
   for (int n = 0; n < N; ++n) {
@@ -769,11 +809,12 @@ TEST(LiePoisson, SymmetryAxisOfATopPrecessesAboutLAtLOverIPerp) {
     const auto [a_perp, cos_a] = transverse(x);
     swept += std::atan2(L_hat.dot(previous.cross(a_perp)), previous.dot(a_perp));
     previous = a_perp;
-    worst_cone = std::max(worst_cone, std::abs(cos_a - cos_cone));
+    worst_cone.update(std::abs(cos_a - cos_cone),
+                      [&] { return describe("step", n, "x_{n+1}", x, "cos ϑ", cos_a); });
   }
   const double rate = swept / (N * h);
   EXPECT_NEAR(rate, L / top.I_perp, 1e-6 * L / top.I_perp);
-  EXPECT_LE(worst_cone, 1e-6);
+  EXPECT_LE(worst_cone.value(), 1e-6) << worst_cone;
 }
 
 // ----------------------------------------------------------------------------------------------
@@ -788,8 +829,8 @@ TEST(LiePoisson, SymmetryAxisOfATopPrecessesAboutLAtLOverIPerp) {
 // (tolerance 1e-14).
 TEST(ImplicitGyroscopic, IsOneNewtonStepOnTheImplicitEulerEquations) {
   grbd::test::Random rng(3101);
-  double worst_newton = 0.0;
-  double worst_q = 0.0;
+  WorstCase worst_newton;
+  WorstCase worst_q;
   for (int n = 0; n < 10000; ++n) {
     const RigidBody body = random_body(rng);
     const State x = random_state(rng);
@@ -803,13 +844,17 @@ TEST(ImplicitGyroscopic, IsOneNewtonStepOnTheImplicitEulerEquations) {
                             h * (w.cross(body.K_Theta.cwiseProduct(delta)) - Theta_w.cross(delta));
     const Vector3 f = h * (w.cross(Theta_w) - loads.K_M);
     const double scale = body.K_Theta.maxCoeff() * (w.norm() + y.u.tail<3>().norm()) + f.norm();
-    worst_newton = std::max(worst_newton, (J_delta + f).norm() / scale);
+    const auto inputs = [&] {
+      return describe("body", body, "x", x, "loads", loads, "h", h);
+    };
+    worst_newton.update((J_delta + f).norm() / scale, n, inputs);
     const Vector3 v = x.u.head<3>() + h * loads.I_F / body.m;
-    worst_q = std::max({worst_q, max_abs(y.u.head<3>() - v),
-                        max_abs(y.q - exact_motion(x.q, make_u(v, y.u.tail<3>()), h))});
+    worst_q.update(max_abs(y.u.head<3>() - v), n, [&] { return "v⁺, " + inputs(); });
+    worst_q.update(max_abs(y.q - exact_motion(x.q, make_u(v, y.u.tail<3>()), h)), n,
+                   [&] { return "q⁺, " + inputs(); });
   }
-  EXPECT_LE(worst_newton, 1e-14);
-  EXPECT_LE(worst_q, 1e-14);
+  EXPECT_LE(worst_newton.value(), 1e-14) << worst_newton;
+  EXPECT_LE(worst_q.value(), 1e-14) << worst_q;
 }
 
 // Reference: Catto (2015). A thin rod (radius 5 cm, length 1 m, 1 kg: Θ = (1.25e-3, 0.0840,
@@ -826,7 +871,7 @@ TEST(ImplicitGyroscopic, NeverGainsEnergyOnAFastSpinningRodWhereTheExplicitSchem
       1.0, Vector3(0.5 * radius * radius, (3.0 * radius * radius + length * length) / 12.0,
                    (3.0 * radius * radius + length * length) / 12.0)};
   grbd::test::Random rng(3102);
-  double worst_gain = 0.0;
+  WorstCase worst_gain;
   double smallest_explicit_growth = std::numeric_limits<double>::infinity();
   for (int run = 0; run < 20; ++run) {
     const double steps[] = {1.0 / 60.0, 1.0 / 30.0, 0.1};
@@ -838,7 +883,9 @@ TEST(ImplicitGyroscopic, NeverGainsEnergyOnAFastSpinningRodWhereTheExplicitSchem
     for (int n = 0; n < 1000; ++n) {
       const State y = grbd::body::implicit_gyroscopic_step(rod, x, Loads{}, h);
       const double E = grbd::body::kinetic_energy(rod, x.u);
-      worst_gain = std::max(worst_gain, (grbd::body::kinetic_energy(rod, y.u) - E) / (kEps * E));
+      worst_gain.update((grbd::body::kinetic_energy(rod, y.u) - E) / (kEps * E), [&] {
+        return describe("run", run, "h", h, "x_0", x0, "step", n, "x_n", x);
+      });
       x = y;
     }
     State a = x0;
@@ -847,7 +894,8 @@ TEST(ImplicitGyroscopic, NeverGainsEnergyOnAFastSpinningRodWhereTheExplicitSchem
         std::min(smallest_explicit_growth,
                  grbd::body::kinetic_energy(rod, a.u) / grbd::body::kinetic_energy(rod, x0.u));
   }
-  EXPECT_LE(worst_gain, 4.0) << "largest one-step energy gain of (e), in units of eps E";
+  EXPECT_LE(worst_gain.value(), 4.0)
+      << "largest one-step energy gain of (e), in units of eps E; " << worst_gain;
   EXPECT_GE(smallest_explicit_growth, 2.0) << "energy factor of (a) after 20 steps";
 }
 

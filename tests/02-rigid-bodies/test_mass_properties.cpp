@@ -36,6 +36,7 @@
 #include "grbd_test/bodies.hpp"
 #include "grbd_test/random.hpp"
 #include "grbd_test/references.hpp"
+#include "grbd_test/worst_case.hpp"
 
 namespace {
 
@@ -50,7 +51,9 @@ using grbd::body::tetrahedron_integrals;
 using grbd::body::TriangleMesh;
 using grbd::body::VolumeIntegrals;
 using grbd::test::box_inertia;
+using grbd::test::describe;
 using grbd::test::max_abs;
+using grbd::test::WorstCase;
 
 constexpr double pi = std::numbers::pi;
 
@@ -212,17 +215,21 @@ TEST(Exercise2_1, UnitCornerTetrahedronHasTheDirichletIntegrals) {
 // nearly flat tetrahedron may be much larger, in both computations alike.
 TEST(Exercise2_1, RandomTrianglesMatchTheAffineImageOfTheCornerTetrahedron) {
   grbd::test::Random rng(2101);
-  double worst = 0.0;
+  WorstCase worst;
   for (int n = 0; n < 1000; ++n) {
     const Vector3 a = rng.vector3(), b = rng.vector3(), c = rng.vector3();
     const VolumeIntegrals I = tetrahedron_integrals(a, b, c);
     const VolumeIntegrals ref = affine_tetrahedron(Vector3::Zero(), a, b, c);
     const double scale = a.norm() * b.norm() * c.norm();  // |x| ≤ √3: all moments ≲ 3 scale
-    worst = std::max(worst, std::abs(I.volume - ref.volume) / scale);
-    worst = std::max(worst, (I.first - ref.first).cwiseAbs().maxCoeff() / scale);
-    worst = std::max(worst, max_abs(I.second - ref.second) / scale);
+    const auto inputs = [&] { return describe("a", a, "b", b, "c", c); };
+    worst.update(std::abs(I.volume - ref.volume) / scale, n,
+                 [&] { return "volume, " + inputs(); });
+    worst.update((I.first - ref.first).cwiseAbs().maxCoeff() / scale, n,
+                 [&] { return "first moments, " + inputs(); });
+    worst.update(max_abs(I.second - ref.second) / scale, n,
+                 [&] { return "second moments, " + inputs(); });
   }
-  EXPECT_LE(worst, 1e-14);
+  EXPECT_LE(worst.value(), 1e-14) << worst;
 }
 
 // Reference: the orientation rule: (a, c, b) is (a, b, c) seen from the other side, so every
@@ -230,17 +237,20 @@ TEST(Exercise2_1, RandomTrianglesMatchTheAffineImageOfTheCornerTetrahedron) {
 // another order, e.g. (a × b)·c, so the negation need not be exact).
 TEST(Exercise2_1, ReversingTheTriangleNegatesEveryIntegral) {
   grbd::test::Random rng(2102);
-  double worst = 0.0;
+  WorstCase worst;
   for (int n = 0; n < 100; ++n) {
     const Vector3 a = rng.vector3(), b = rng.vector3(), c = rng.vector3();
     const VolumeIntegrals I = tetrahedron_integrals(a, b, c);
     const VolumeIntegrals J = tetrahedron_integrals(a, c, b);
     const double scale = a.norm() * b.norm() * c.norm();
-    worst = std::max(worst, std::abs(J.volume + I.volume) / scale);
-    worst = std::max(worst, (J.first + I.first).cwiseAbs().maxCoeff() / scale);
-    worst = std::max(worst, max_abs(J.second + I.second) / scale);
+    const auto inputs = [&] { return describe("a", a, "b", b, "c", c); };
+    worst.update(std::abs(J.volume + I.volume) / scale, n, [&] { return "volume, " + inputs(); });
+    worst.update((J.first + I.first).cwiseAbs().maxCoeff() / scale, n,
+                 [&] { return "first moments, " + inputs(); });
+    worst.update(max_abs(J.second + I.second) / scale, n,
+                 [&] { return "second moments, " + inputs(); });
   }
-  EXPECT_LE(worst, 1e-15);
+  EXPECT_LE(worst.value(), 1e-15) << worst;
 }
 
 // Reference: the divergence theorem: over the four outward faces of any tetrahedron the
@@ -249,7 +259,7 @@ TEST(Exercise2_1, ReversingTheTriangleNegatesEveryIntegral) {
 // single contributions up to ~100 times larger than their sum.
 TEST(Exercise2_1, ContributionsOfTheFacesOfATetrahedronSumToItsIntegrals) {
   grbd::test::Random rng(2103);
-  double worst = 0.0;
+  WorstCase worst;
   for (int n = 0; n < 300; ++n) {
     const Vector3 offset = rng.vector3(-2, 2);
     std::array<Vector3, 4> p = {offset + rng.vector3(), offset + rng.vector3(),
@@ -261,12 +271,15 @@ TEST(Exercise2_1, ContributionsOfTheFacesOfATetrahedronSumToItsIntegrals) {
     sum += tetrahedron_integrals(p[0], p[1], p[3]);
     sum += tetrahedron_integrals(p[0], p[3], p[2]);
     sum += tetrahedron_integrals(p[1], p[2], p[3]);
-    worst = std::max(worst, std::abs(sum.volume - ref.volume) / ref.volume);
-    worst = std::max(
-        worst, (sum.first - ref.first).cwiseAbs().maxCoeff() / ref.first.cwiseAbs().maxCoeff());
-    worst = std::max(worst, relative(sum.second, ref.second));
+    const auto inputs = [&] { return describe("vertices", p); };
+    worst.update(std::abs(sum.volume - ref.volume) / ref.volume, n,
+                 [&] { return "volume, " + inputs(); });
+    worst.update((sum.first - ref.first).cwiseAbs().maxCoeff() / ref.first.cwiseAbs().maxCoeff(),
+                 n, [&] { return "first moments, " + inputs(); });
+    worst.update(relative(sum.second, ref.second), n,
+                 [&] { return "second moments, " + inputs(); });
   }
-  EXPECT_LE(worst, 1e-12);
+  EXPECT_LE(worst.value(), 1e-12) << worst;
 }
 
 // ----------------------------------------------------------------------------------------------
@@ -281,16 +294,17 @@ TEST(Exercise2_1, ContributionsOfTheFacesOfATetrahedronSumToItsIntegrals) {
 // ~40 times Θ_S lose about two digits in Steiner's shift.
 TEST(Exercise2_2, OffsetBoxesHaveTheBoxTableInertia) {
   grbd::test::Random rng(2201);
-  double worst = 0.0;
+  WorstCase worst;
   for (int n = 0; n < 300; ++n) {
     const Vector3 centre = rng.vector3(-2, 2);
     const Vector3 h = rng.vector3(0.2, 1.0);
     const double density = rng.uniform(500.0, 8000.0);
     const Matrix3 Theta =
         inertia_about_centre_of_mass(box_integrals(centre - h, centre + h), density);
-    worst = std::max(worst, relative(Theta, box_inertia(h, density * 8.0 * h.prod())));
+    worst.update(relative(Theta, box_inertia(h, density * 8.0 * h.prod())), n,
+                 [&] { return describe("centre", centre, "h", h, "density", density); });
   }
-  EXPECT_LE(worst, 1e-12);
+  EXPECT_LE(worst.value(), 1e-12) << worst;
 }
 
 // Reference: the unit corner tetrahedron's Dirichlet integrals give, with ρ = 1, Θ_S with
@@ -312,7 +326,7 @@ TEST(Exercise2_2, UnitCornerTetrahedronHasTononsInertia) {
 // A Θ_box Aᵀ. Seeded random motions; tolerance 1e-12 relative (as for the offset boxes).
 TEST(Exercise2_2, RotatedTranslatedSolidsHaveTheRotatedInertia) {
   grbd::test::Random rng(2202);
-  double worst = 0.0;
+  WorstCase worst;
   for (int n = 0; n < 300; ++n) {
     const Matrix3 A = rng.rotation();
     const Vector3 r = rng.vector3(-2, 2);
@@ -325,9 +339,10 @@ TEST(Exercise2_2, RotatedTranslatedSolidsHaveTheRotatedInertia) {
     I.second = A * C * A.transpose() + I.volume * r * r.transpose();
     const Matrix3 Theta = inertia_about_centre_of_mass(I, density);
     const Matrix3 expected = A * box_inertia(h, density * I.volume) * A.transpose();
-    worst = std::max(worst, relative(Theta, expected));
+    worst.update(relative(Theta, expected), n,
+                 [&] { return describe("A", A, "r", r, "h", h, "density", density); });
   }
-  EXPECT_LE(worst, 1e-12);
+  EXPECT_LE(worst.value(), 1e-12) << worst;
 }
 
 // ----------------------------------------------------------------------------------------------
@@ -371,7 +386,7 @@ TEST(MassProperties, UnitCornerTetrahedronMeshIsExact) {
 // relative: thin random tetrahedra lose a few digits in both computations.
 TEST(MassProperties, GeneralTetrahedronMatchesTonon) {
   grbd::test::Random rng(2302);
-  double worst = 0.0;
+  WorstCase worst;
   for (int n = 0; n < 200; ++n) {
     const Vector3 offset = rng.vector3(-3, 3);
     const std::array<Vector3, 4> p = {offset + rng.vector3(), offset + rng.vector3(),
@@ -384,9 +399,10 @@ TEST(MassProperties, GeneralTetrahedronMatchesTonon) {
     EXPECT_NEAR(props.volume, volume, 1e-13 * volume);
     const Vector3 centroid = (p[0] + p[1] + p[2] + p[3]) / 4.0;
     EXPECT_LE((props.M_r_S - centroid).cwiseAbs().maxCoeff(), 1e-13 * (1.0 + centroid.norm()));
-    worst = std::max(worst, relative(props.M_Theta_S, tonon_inertia(p, density)));
+    worst.update(relative(props.M_Theta_S, tonon_inertia(p, density)), n,
+                 [&] { return describe("vertices", p, "density", density); });
   }
-  EXPECT_LE(worst, 1e-12);
+  EXPECT_LE(worst.value(), 1e-12) << worst;
 }
 
 // Reference: the regular n-gon prism inscribed in the cylinder (circumradius R, height h), made
@@ -500,26 +516,26 @@ TEST(MassProperties, InvariantUnderRigidMotions) {
   ASSERT_GT(axes.K_Theta[1] - axes.K_Theta[0], 1e-2 * axes.K_Theta[2]);
   ASSERT_GT(axes.K_Theta[2] - axes.K_Theta[1], 1e-2 * axes.K_Theta[2]);
   grbd::test::Random rng(2303);
-  double mass_error = 0.0, position_error = 0.0, inertia_error = 0.0, moment_error = 0.0;
+  WorstCase mass_error, position_error, inertia_error, moment_error;
   for (int n = 0; n < 50; ++n) {
     const Matrix3 A = rng.rotation();
     const Vector3 r = rng.vector3(-2, 2);
     const MassProperties moved =
         mass_properties(grbd::body::transformed(body, A, r), density, "moved torus");
-    mass_error = std::max(mass_error, std::abs(moved.mass - props.mass) / props.mass);
-    position_error =
-        std::max(position_error, (moved.M_r_S - (A * props.M_r_S + r)).cwiseAbs().maxCoeff());
-    inertia_error =
-        std::max(inertia_error, relative(moved.M_Theta_S, A * props.M_Theta_S * A.transpose()));
-    moment_error =
-        std::max(moment_error,
-                 (principal_axes(moved.M_Theta_S).K_Theta - axes.K_Theta).cwiseAbs().maxCoeff() /
-                     axes.K_Theta[2]);
+    const auto inputs = [&] { return describe("A", A, "r", r); };
+    mass_error.update(std::abs(moved.mass - props.mass) / props.mass, n, inputs);
+    position_error.update((moved.M_r_S - (A * props.M_r_S + r)).cwiseAbs().maxCoeff(), n, inputs);
+    inertia_error.update(relative(moved.M_Theta_S, A * props.M_Theta_S * A.transpose()), n,
+                         inputs);
+    moment_error.update(
+        (principal_axes(moved.M_Theta_S).K_Theta - axes.K_Theta).cwiseAbs().maxCoeff() /
+            axes.K_Theta[2],
+        n, inputs);
   }
-  EXPECT_LE(mass_error, 1e-13);
-  EXPECT_LE(position_error, 1e-13);
-  EXPECT_LE(inertia_error, 1e-12);
-  EXPECT_LE(moment_error, 1e-12);
+  EXPECT_LE(mass_error.value(), 1e-13) << mass_error;
+  EXPECT_LE(position_error.value(), 1e-13) << position_error;
+  EXPECT_LE(inertia_error.value(), 1e-12) << inertia_error;
+  EXPECT_LE(moment_error.value(), 1e-12) << moment_error;
 }
 
 // Reference: the contract: the mesh is checked first (MeshError whose message starts with the

@@ -32,6 +32,7 @@
 #include "grbd/body/triangle_mesh.hpp"
 #include "grbd/core/error.hpp"
 #include "grbd_test/random.hpp"
+#include "grbd_test/worst_case.hpp"
 
 namespace {
 
@@ -46,6 +47,8 @@ using grbd::body::read_obj;
 using grbd::body::require_closed_oriented;
 using grbd::body::TriangleMesh;
 using grbd::body::write_obj;
+using grbd::test::describe;
+using grbd::test::WorstCase;
 
 constexpr double pi = std::numbers::pi;
 
@@ -705,12 +708,13 @@ TEST(MeshGenerators, TorusIsClosedOutwardAndOnTheSurface) {
     return Vector3(R * x.x() / rho, R * x.y() / rho, 0.0);
   };
   expect_closed_outward(mesh, 0, centre_line, "torus");
-  double worst = 0.0;
+  WorstCase worst;
   for (Eigen::Index i = 0; i < mesh.V.rows(); ++i) {
     const double rho = std::hypot(mesh.V(i, 0), mesh.V(i, 1));
-    worst = std::max(worst, std::abs((rho - R) * (rho - R) + mesh.V(i, 2) * mesh.V(i, 2) - r * r));
+    worst.update(std::abs((rho - R) * (rho - R) + mesh.V(i, 2) * mesh.V(i, 2) - r * r),
+                 [&] { return describe("vertex", i, "V", mesh.V.row(i)); });
   }
-  EXPECT_LE(worst, 1e-15);
+  EXPECT_LE(worst.value(), 1e-15) << worst;
   EXPECT_GT(signed_volume(mesh), 0.0);
   EXPECT_LT(signed_volume(mesh), 2.0 * pi * pi * R * r * r);  // inscribed in each section
 }
@@ -776,12 +780,14 @@ TEST(MeshTransform, RigidMotionMapsEveryVertexAndKeepsTheFaces) {
     const Vector3 r = rng.vector3(-5, 5);
     const TriangleMesh image = grbd::body::transformed(mesh, A, r);
     EXPECT_EQ(image.F, mesh.F);
-    double worst = 0.0;
+    WorstCase worst;
     for (Eigen::Index i = 0; i < mesh.V.rows(); ++i) {
       const Vector3 expected = A * mesh.V.row(i).transpose() + r;
-      worst = std::max(worst, (image.V.row(i).transpose() - expected).cwiseAbs().maxCoeff());
+      worst.update((image.V.row(i).transpose() - expected).cwiseAbs().maxCoeff(), [&] {
+        return describe("sample", sample, "A", A, "r", r, "vertex", i, "V", mesh.V.row(i));
+      });
     }
-    EXPECT_LE(worst, 1e-15 * 8.0);  // |x| ≤ 6.3: a few ulps
+    EXPECT_LE(worst.value(), 1e-15 * 8.0) << worst;  // |x| ≤ 6.3: a few ulps
     EXPECT_TRUE(analyse_topology(image).closed_oriented_manifold());
     EXPECT_NEAR(signed_volume(image), volume, 1e-13 * volume);
   }

@@ -25,6 +25,7 @@
 #include "grbd_test/bodies.hpp"
 #include "grbd_test/random.hpp"
 #include "grbd_test/references.hpp"
+#include "grbd_test/worst_case.hpp"
 
 namespace {
 
@@ -39,6 +40,7 @@ using grbd::body::RigidBody;
 using grbd::body::State;
 using grbd::kinematics::make_q;
 using grbd::kinematics::make_u;
+using grbd::test::describe;
 using grbd::test::exact_motion;
 using grbd::test::gyroscopic_torque;
 using grbd::test::max_abs;
@@ -46,6 +48,7 @@ using grbd::test::random_body;
 using grbd::test::random_loads;
 using grbd::test::random_state;
 using grbd::test::reference_A_IK;
+using grbd::test::WorstCase;
 
 constexpr double kEps = std::numeric_limits<double>::epsilon();
 
@@ -65,7 +68,7 @@ constexpr double kDifferenceTol = 1e-8;
 TEST(Exercise2_3, MatchesCentralDifferencesOfPointPositionAlongAMotion) {
   using grbd::kinematics::point_position;
   grbd::test::Random rng(2301);
-  double worst = 0.0;
+  WorstCase worst;
   for (int n = 0; n < 2000; ++n) {
     const State x = random_state(rng);
     const Vector3 rho = rng.vector3();
@@ -73,23 +76,25 @@ TEST(Exercise2_3, MatchesCentralDifferencesOfPointPositionAlongAMotion) {
                                 point_position(exact_motion(x.q, x.u, -kDelta), rho)) /
                                (2.0 * kDelta);
     const Matrix36 J_P = grbd::body::point_jacobian(x.q, rho);
-    worst = std::max(worst, max_abs(J_P * x.u - difference));
+    worst.update(max_abs(J_P * x.u - difference), n,
+                 [&] { return describe("x", x, "rho", rho); });
   }
-  EXPECT_LE(worst, kDifferenceTol);
+  EXPECT_LE(worst.value(), kDifferenceTol) << worst;
 }
 
 // Reference: point_velocity() of chapter 1, I_v_P = I_v_S + A_IK (K_ω × K_ρ). Entries up to
 // |v| + |ω||ρ| ≈ 10, a handful of roundings each: tolerance 1e-14.
 TEST(Exercise2_3, TimesUIsThePointVelocity) {
   grbd::test::Random rng(2302);
-  double worst = 0.0;
+  WorstCase worst;
   for (int n = 0; n < 10000; ++n) {
     const State x = random_state(rng);
     const Vector3 rho = rng.vector3();
     const Vector3 expected = grbd::kinematics::point_velocity(x.q, x.u, rho);
-    worst = std::max(worst, max_abs(grbd::body::point_jacobian(x.q, rho) * x.u - expected));
+    worst.update(max_abs(grbd::body::point_jacobian(x.q, rho) * x.u - expected), n,
+                 [&] { return describe("x", x, "rho", rho); });
   }
-  EXPECT_LE(worst, 1e-14);
+  EXPECT_LE(worst.value(), 1e-14) << worst;
 }
 
 // Reference: the columns written out from the spatial formula: ∂v_P/∂v_S = I₃ exactly, and
@@ -97,7 +102,7 @@ TEST(Exercise2_3, TimesUIsThePointVelocity) {
 // matrices differ by ~2 ulps, the products add ~3 roundings: tolerance 4e-15 (≈ 8 eps √3).
 TEST(Exercise2_3, ColumnsAreTheVelocitiesOfUnitMotions) {
   grbd::test::Random rng(2303);
-  double worst = 0.0;
+  WorstCase worst;
   for (int n = 0; n < 10000; ++n) {
     const State x = random_state(rng);
     const Vector3 rho = rng.vector3();
@@ -105,26 +110,27 @@ TEST(Exercise2_3, ColumnsAreTheVelocitiesOfUnitMotions) {
     ASSERT_EQ(Matrix3(J_P.leftCols<3>()), Matrix3::Identity());
     const Matrix3 A = reference_A_IK(x.q);
     for (int j = 0; j < 3; ++j) {
-      worst = std::max(worst, max_abs(J_P.col(3 + j) - A * Vector3::Unit(j).cross(rho)));
+      worst.update(max_abs(J_P.col(3 + j) - A * Vector3::Unit(j).cross(rho)), n,
+                   [&] { return describe("column", 3 + j, "q", x.q, "rho", rho); });
     }
   }
-  EXPECT_LE(worst, 4e-15);
+  EXPECT_LE(worst.value(), 4e-15) << worst;
 }
 
 // Reference: generalized_force(), which writes J_Pᵀ F as (F, K_ρ × A_IKᵀ F) without the Jacobian.
 // Entries ≤ |ρ||F| ≈ 3: tolerance 1e-14.
 TEST(Exercise2_3, TransposeMapsAForceToTheGeneralizedForce) {
   grbd::test::Random rng(2304);
-  double worst = 0.0;
+  WorstCase worst;
   for (int n = 0; n < 10000; ++n) {
     const State x = random_state(rng);
     const Vector3 rho = rng.vector3();
     const Vector3 F = rng.vector3();
     const Vector6 expected = grbd::body::generalized_force(x.q, rho, F);
-    worst =
-        std::max(worst, max_abs(grbd::body::point_jacobian(x.q, rho).transpose() * F - expected));
+    worst.update(max_abs(grbd::body::point_jacobian(x.q, rho).transpose() * F - expected), n,
+                 [&] { return describe("q", x.q, "rho", rho, "F", F); });
   }
-  EXPECT_LE(worst, 1e-14);
+  EXPECT_LE(worst.value(), 1e-14) << worst;
 }
 
 // ----------------------------------------------------------------------------------------------
@@ -153,7 +159,7 @@ TEST(Exercise2_4, MatchesHandComputedEulerEquations) {
 // 1e-13.
 TEST(Exercise2_4, EqualsEulersEquationsInComponents) {
   grbd::test::Random rng(2401);
-  double worst = 0.0;
+  WorstCase worst;
   for (int n = 0; n < 10000; ++n) {
     const RigidBody body = random_body(rng);
     const State x = random_state(rng);
@@ -161,9 +167,10 @@ TEST(Exercise2_4, EqualsEulersEquationsInComponents) {
     const Vector6 h = grbd::body::newton_euler_h(body, x.u, loads);
     ASSERT_EQ(Vector3(h.head<3>()), loads.I_F);
     const Vector3 expected = loads.K_M + gyroscopic_torque(body, x.u.tail<3>());
-    worst = std::max(worst, max_abs(h.tail<3>() - expected));
+    worst.update(max_abs(h.tail<3>() - expected), n,
+                 [&] { return describe("body", body, "u", x.u, "loads", loads); });
   }
-  EXPECT_LE(worst, 1e-13);
+  EXPECT_LE(worst.value(), 1e-13) << worst;
 }
 
 // Reference: the power balance. The gyroscopic term does no work, ω · (ω × Θω) = 0, so
@@ -171,16 +178,17 @@ TEST(Exercise2_4, EqualsEulersEquationsInComponents) {
 // a few roundings each: tolerance 1e-13.
 TEST(Exercise2_4, GyroscopicTermDoesNoWork) {
   grbd::test::Random rng(2402);
-  double worst = 0.0;
+  WorstCase worst;
   for (int n = 0; n < 10000; ++n) {
     const RigidBody body = random_body(rng);
     const State x = random_state(rng);
     const Loads loads = random_loads(rng);
     const Vector6 h = grbd::body::newton_euler_h(body, x.u, loads);
     const double power = x.u.head<3>().dot(loads.I_F) + x.u.tail<3>().dot(loads.K_M);
-    worst = std::max(worst, std::abs(x.u.dot(h) - power));
+    worst.update(std::abs(x.u.dot(h) - power), n,
+                 [&] { return describe("body", body, "u", x.u, "loads", loads); });
   }
-  EXPECT_LE(worst, 1e-13);
+  EXPECT_LE(worst.value(), 1e-13) << worst;
 }
 
 // Reference: a body spinning about a principal axis with no load is in steady rotation
@@ -209,7 +217,7 @@ TEST(MassMatrix, IsDiagonalInThePrincipalFrame) {
 // ≤ ~40: tolerance 1e-13.
 TEST(KineticEnergy, IsHalfTheMassMatrixNorm) {
   grbd::test::Random rng(2501);
-  double worst = 0.0;
+  WorstCase worst;
   for (int n = 0; n < 10000; ++n) {
     const RigidBody body = random_body(rng);
     const State x = random_state(rng);
@@ -217,22 +225,26 @@ TEST(KineticEnergy, IsHalfTheMassMatrixNorm) {
     const double by_matrix = 0.5 * x.u.dot(grbd::body::mass_matrix(body) * x.u);
     double by_hand = 0.5 * body.m * x.u.head<3>().squaredNorm();
     for (int i = 0; i < 3; ++i) by_hand += 0.5 * body.K_Theta[i] * x.u[3 + i] * x.u[3 + i];
-    worst = std::max({worst, std::abs(T - by_matrix), std::abs(T - by_hand)});
+    worst.update(std::abs(T - by_matrix), n,
+                 [&] { return "½ uᵀMu, " + describe("body", body, "u", x.u); });
+    worst.update(std::abs(T - by_hand), n,
+                 [&] { return "by hand, " + describe("body", body, "u", x.u); });
   }
-  EXPECT_LE(worst, 1e-13);
+  EXPECT_LE(worst.value(), 1e-13) << worst;
 }
 
 // Reference: I_L = A_IK Θ K_ω with A_IK from Eigen::Quaterniond. Entries ≤ ~10: tolerance 1e-14.
 TEST(AngularMomentum, IsTheBodyMomentumInTheInertialFrame) {
   grbd::test::Random rng(2502);
-  double worst = 0.0;
+  WorstCase worst;
   for (int n = 0; n < 10000; ++n) {
     const RigidBody body = random_body(rng);
     const State x = random_state(rng);
     const Vector3 expected = reference_A_IK(x.q) * body.K_Theta.cwiseProduct(x.u.tail<3>());
-    worst = std::max(worst, max_abs(grbd::body::I_angular_momentum(body, x) - expected));
+    worst.update(max_abs(grbd::body::I_angular_momentum(body, x) - expected), n,
+                 [&] { return describe("body", body, "x", x); });
   }
-  EXPECT_LE(worst, 1e-14);
+  EXPECT_LE(worst.value(), 1e-14) << worst;
 }
 
 // Reference: the closed-form torque-free symmetric top (REFERENCES.md), I₁ = I₂ = I⊥:
@@ -243,21 +255,21 @@ TEST(AngularMomentum, IsConstantAlongTheTorqueFreeSymmetricTop) {
   const grbd::test::SymmetricTop top(RigidBody{1.0, Vector3(0.8, 0.8, 0.3)},
                                      Vector3(0.7, -0.4, 3.0),
                                      grbd::test::axis_angle_matrix(Vector3(0.3, -1.1, 0.4)));
-  double worst = 0.0;
+  WorstCase worst;
   for (double t = 0.0; t <= 20.0; t += 0.25) {
     const State x{make_q(Vector3::Zero(), grbd::test::reference_quaternion(top.A(t))),
                   make_u(Vector3::Zero(), top.omega(t))};
-    worst = std::max(
-        worst, (grbd::body::I_angular_momentum(top.body, x) - top.I_L).norm() / top.I_L.norm());
+    worst.update((grbd::body::I_angular_momentum(top.body, x) - top.I_L).norm() / top.I_L.norm(),
+                 [&] { return describe("t", t, "x(t)", x); });
   }
-  EXPECT_LE(worst, 1e-14);
+  EXPECT_LE(worst.value(), 1e-14) << worst;
 }
 
 // Reference: the virtual work of a force at a material point, uᵀ (J_Pᵀ F) = F · v_P, with v_P
 // from the spatial formula v_S + I_ω × I_ρ (Eigen rotation matrix). Powers ≤ ~10: tolerance 1e-13.
 TEST(GeneralizedForce, DoesTheVirtualWorkOfTheForce) {
   grbd::test::Random rng(2503);
-  double worst = 0.0;
+  WorstCase worst;
   for (int n = 0; n < 10000; ++n) {
     const State x = random_state(rng);
     const Vector3 rho = rng.vector3();
@@ -265,9 +277,10 @@ TEST(GeneralizedForce, DoesTheVirtualWorkOfTheForce) {
     const Matrix3 A = reference_A_IK(x.q);
     const Vector3 v_P = x.u.head<3>() + (A * x.u.tail<3>()).cross(A * rho);
     const Vector6 f = grbd::body::generalized_force(x.q, rho, F);
-    worst = std::max(worst, std::abs(x.u.dot(f) - F.dot(v_P)));
+    worst.update(std::abs(x.u.dot(f) - F.dot(v_P)), n,
+                 [&] { return describe("x", x, "rho", rho, "F", F); });
   }
-  EXPECT_LE(worst, 1e-13);
+  EXPECT_LE(worst.value(), 1e-13) << worst;
 }
 
 // Reference: statics. A force through S adds no moment, (F, 0) exactly; a couple (F at +ρ, −F at
@@ -275,7 +288,7 @@ TEST(GeneralizedForce, DoesTheVirtualWorkOfTheForce) {
 // Entries ≤ ~10: tolerance 1e-14.
 TEST(GeneralizedForce, ForceThroughTheCentreAndCouple) {
   grbd::test::Random rng(2504);
-  double worst = 0.0;
+  WorstCase worst;
   for (int n = 0; n < 10000; ++n) {
     const State x = random_state(rng);
     const Vector3 rho = rng.vector3();
@@ -286,10 +299,12 @@ TEST(GeneralizedForce, ForceThroughTheCentreAndCouple) {
     const Vector6 couple =
         grbd::body::generalized_force(x.q, rho, F) + grbd::body::generalized_force(x.q, -rho, -F);
     const Matrix3 A = reference_A_IK(x.q);
-    worst = std::max(worst, max_abs(couple.head<3>()));
-    worst = std::max(worst, max_abs(couple.tail<3>() - A.transpose() * (2.0 * (A * rho).cross(F))));
+    worst.update(max_abs(couple.head<3>()), n,
+                 [&] { return "force of the couple, " + describe("q", x.q, "rho", rho, "F", F); });
+    worst.update(max_abs(couple.tail<3>() - A.transpose() * (2.0 * (A * rho).cross(F))), n,
+                 [&] { return "moment of the couple, " + describe("q", x.q, "rho", rho, "F", F); });
   }
-  EXPECT_LE(worst, 1e-14);
+  EXPECT_LE(worst.value(), 1e-14) << worst;
 }
 
 // Reference: Euler's equations solved for ω̇ by hand, ω̇_i = (M_i + (Θ_j − Θ_k) ω_j ω_k)/Θ_i,
@@ -297,7 +312,7 @@ TEST(GeneralizedForce, ForceThroughTheCentreAndCouple) {
 // tolerance 2e-13 (≈ 8 eps · 130).
 TEST(NewtonEulerUDot, SolvesTheNewtonEulerEquations) {
   grbd::test::Random rng(2505);
-  double worst = 0.0;
+  WorstCase worst;
   for (int n = 0; n < 10000; ++n) {
     const RigidBody body = random_body(rng);
     const State x = random_state(rng);
@@ -306,11 +321,13 @@ TEST(NewtonEulerUDot, SolvesTheNewtonEulerEquations) {
     Vector6 expected;
     expected << loads.I_F / body.m,
         (loads.K_M + gyroscopic_torque(body, x.u.tail<3>())).cwiseQuotient(body.K_Theta);
-    worst = std::max(worst, max_abs(u_dot - expected));
-    worst = std::max(worst, max_abs(grbd::body::mass_matrix(body) * u_dot -
-                                    grbd::body::newton_euler_h(body, x.u, loads)));
+    const auto inputs = [&] { return describe("body", body, "u", x.u, "loads", loads); };
+    worst.update(max_abs(u_dot - expected), n, [&] { return "u̇ by hand, " + inputs(); });
+    worst.update(max_abs(grbd::body::mass_matrix(body) * u_dot -
+                         grbd::body::newton_euler_h(body, x.u, loads)),
+                 n, [&] { return "M u̇ = h, " + inputs(); });
   }
-  EXPECT_LE(worst, 2e-13);
+  EXPECT_LE(worst.value(), 2e-13) << worst;
 }
 
 // Reference: the preconditions of rigid_body.hpp — m > 0 and K_Theta > 0, finite — are checked

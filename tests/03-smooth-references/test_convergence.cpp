@@ -24,6 +24,7 @@
 #include "grbd/ode/rigid_body_rhs.hpp"
 #include "grbd/ode/sundials.hpp"
 #include "grbd_test/references.hpp"
+#include "grbd_test/worst_case.hpp"
 
 namespace {
 
@@ -36,6 +37,8 @@ using grbd::kinematics::make_q;
 using grbd::kinematics::make_u;
 using grbd::kinematics::Quaternion;
 using grbd::ode::observed_order;
+using grbd::test::describe;
+using grbd::test::WorstCase;
 
 constexpr double kEps = std::numeric_limits<double>::epsilon();
 
@@ -72,15 +75,16 @@ TEST(Exercise3_3, IsExactOnPowerLaws) {
       {1.0, 0.3, 0.21, 0.05, 0.011, 2e-3, 7e-4, 1e-6},
       {4e-6, 2e-6, 1e-6},
   };
-  double worst = 0.0;
+  WorstCase worst;
   for (const auto& h : step_sizes) {
     for (double p : {0.5, 1.0, 2.0, 3.7, -1.0}) {
       for (double C : {1e-3, 1.0, 250.0}) {
-        worst = std::max(worst, std::abs(observed_order(h, power_law(h, C, p)) - p));
+        worst.update(std::abs(observed_order(h, power_law(h, C, p)) - p),
+                     [&] { return describe("h", h, "C", C, "p", p); });
       }
     }
   }
-  EXPECT_LE(worst, 1e-12);
+  EXPECT_LE(worst.value(), 1e-12) << worst;
 }
 
 // Reference: for two pairs the least-squares line passes through both points: the slope is

@@ -26,6 +26,7 @@
 #include "grbd_test/bodies.hpp"
 #include "grbd_test/random.hpp"
 #include "grbd_test/references.hpp"
+#include "grbd_test/worst_case.hpp"
 
 namespace {
 
@@ -42,6 +43,8 @@ using grbd::ode::CvodeMethod;
 using grbd::ode::EulerTop;
 using grbd::ode::HeavyTop;
 using grbd::ode::RhsFunction;
+using grbd::test::describe;
+using grbd::test::WorstCase;
 using Ref = Eigen::Ref<const Eigen::VectorXd>;
 using Out = Eigen::Ref<Eigen::VectorXd>;
 
@@ -110,22 +113,26 @@ TEST(DetestB5Reference, ExactSolutionSatisfiesTheProblem) {
   EXPECT_NEAR(grbd::ode::detest_b5_exact(K)[0], 1.0, 1e-15);
   const RhsFunction f = grbd::ode::detest_b5();
   const double delta = 1e-3;
-  double worst_identity = 0.0;
-  double worst_ode = 0.0;
+  WorstCase worst_identity;
+  WorstCase worst_ode;
   for (double t = -20.0; t <= 20.0; t += 0.173) {
     const Vector3 y = grbd::ode::detest_b5_exact(t);
-    worst_identity = std::max({worst_identity, std::abs(y[0] * y[0] + y[1] * y[1] - 1.0),
-                               std::abs(y[2] * y[2] + 0.51 * y[0] * y[0] - 1.0)});
+    worst_identity.update(std::abs(y[0] * y[0] + y[1] * y[1] - 1.0),
+                          [&] { return "sn² + cn² = 1, " + describe("t", t, "y(t)", y); });
+    worst_identity.update(std::abs(y[2] * y[2] + 0.51 * y[0] * y[0] - 1.0),
+                          [&] { return "dn² + 0.51 sn² = 1, " + describe("t", t, "y(t)", y); });
     const Vector3 derivative =
         (8.0 * (grbd::ode::detest_b5_exact(t + delta) - grbd::ode::detest_b5_exact(t - delta)) -
          (grbd::ode::detest_b5_exact(t + 2 * delta) - grbd::ode::detest_b5_exact(t - 2 * delta))) /
         (12.0 * delta);
     Eigen::VectorXd y_dot(3);
     f(t, Eigen::VectorXd(y), y_dot);
-    worst_ode = std::max(worst_ode, (y_dot - Eigen::VectorXd(derivative)).cwiseAbs().maxCoeff());
+    worst_ode.update((y_dot - Eigen::VectorXd(derivative)).cwiseAbs().maxCoeff(), [&] {
+      return describe("t", t, "y(t)", y, "f(t, y)", y_dot, "differences", derivative);
+    });
   }
-  EXPECT_LE(worst_identity, 4.0 * kEps);
-  EXPECT_LE(worst_ode, 1e-10);
+  EXPECT_LE(worst_identity.value(), 4.0 * kEps) << worst_identity;
+  EXPECT_LE(worst_ode.value(), 1e-10) << worst_ode;
 }
 
 // Reference: Hull et al. (1972), problem B5, written out; three entries or InvalidArgument.
@@ -149,32 +156,45 @@ TEST(DetestB5Reference, RightHandSideIsProblemB5) {
 // m ∈ [0, 1), period = 4K(m)/λ. Random bodies and branch states; tolerance 1e-13 relative.
 TEST(EulerTop, ParametersSolveEulersEquationsAndKeepTheInvariants) {
   grbd::test::Random rng(3401);
-  double worst = 0.0;
+  WorstCase worst;
   for (int n = 0; n < 200; ++n) {
     const Vector3 Theta = random_moments(rng);
     for (const Vector3& w : branch_states(Theta, rng, 5)) {
       const EulerTop top = grbd::ode::euler_top(Theta, w);
       const Vector3& A = top.A;
       const double scale = Theta.maxCoeff() * A.squaredNorm();
-      worst = std::max(
-          {worst,
-           std::abs(Theta[0] * A[0] * top.lambda - (Theta[2] - Theta[1]) * A[1] * A[2]) / scale,
-           std::abs(Theta[1] * A[1] * top.lambda - (Theta[2] - Theta[0]) * A[0] * A[2]) / scale,
-           std::abs(Theta[2] * A[2] * top.m * top.lambda - (Theta[1] - Theta[0]) * A[0] * A[1]) /
-               scale,
-           std::abs(Theta[0] * A[0] * A[0] + Theta[2] * A[2] * A[2] - two_energy(Theta, w)) /
-               two_energy(Theta, w),
-           std::abs(Theta[0] * Theta[0] * A[0] * A[0] + Theta[2] * Theta[2] * A[2] * A[2] -
-                    momentum2(Theta, w)) /
-               momentum2(Theta, w),
-           std::abs(top.period - 4.0 * boost::math::ellint_1(std::sqrt(top.m)) / top.lambda) /
-               top.period});
+      const auto inputs = [&] {
+        return describe("Theta", Theta, "w", w, "A", A, "lambda", top.lambda, "m", top.m,
+                        "period", top.period);
+      };
+      worst.update(
+          std::abs(Theta[0] * A[0] * top.lambda - (Theta[2] - Theta[1]) * A[1] * A[2]) / scale, n,
+          [&] { return "Θ1 A1 λ, " + inputs(); });
+      worst.update(
+          std::abs(Theta[1] * A[1] * top.lambda - (Theta[2] - Theta[0]) * A[0] * A[2]) / scale, n,
+          [&] { return "Θ2 A2 λ, " + inputs(); });
+      worst.update(
+          std::abs(Theta[2] * A[2] * top.m * top.lambda - (Theta[1] - Theta[0]) * A[0] * A[1]) /
+              scale,
+          n, [&] { return "Θ3 A3 m λ, " + inputs(); });
+      worst.update(
+          std::abs(Theta[0] * A[0] * A[0] + Theta[2] * A[2] * A[2] - two_energy(Theta, w)) /
+              two_energy(Theta, w),
+          n, [&] { return "2E, " + inputs(); });
+      worst.update(std::abs(Theta[0] * Theta[0] * A[0] * A[0] + Theta[2] * Theta[2] * A[2] * A[2] -
+                            momentum2(Theta, w)) /
+                       momentum2(Theta, w),
+                   n, [&] { return "L², " + inputs(); });
+      worst.update(
+          std::abs(top.period - 4.0 * boost::math::ellint_1(std::sqrt(top.m)) / top.lambda) /
+              top.period,
+          n, [&] { return "period, " + inputs(); });
       EXPECT_EQ(top.sign[0], top.sign[1] * top.sign[2]);
       EXPECT_GE(top.m, 0.0);
       EXPECT_LT(top.m, 1.0);
     }
   }
-  EXPECT_LE(worst, 1e-13);
+  EXPECT_LE(worst.value(), 1e-13) << worst;
 }
 
 // Reference: the preconditions of references.hpp: Θ1 < Θ2 < Θ3, positive and finite, and the
@@ -199,15 +219,16 @@ TEST(EulerTop, RejectsTheOtherBranchAndMomentsThatDoNotIncrease) {
 // pattern of ω0: |ω(0) − ω0| ≤ 1e-13 |ω0| (the phase goes through atan2 and F(φ | m)).
 TEST(Exercise3_4, StartsAtTheInitialAngularVelocity) {
   grbd::test::Random rng(3402);
-  double worst = 0.0;
+  WorstCase worst;
   for (int n = 0; n < 200; ++n) {
     const Vector3 Theta = random_moments(rng);
     for (const Vector3& w : branch_states(Theta, rng, 5)) {
       const EulerTop top = grbd::ode::euler_top(Theta, w);
-      worst = std::max(worst, (grbd::ode::euler_top_omega(top, 0.0) - w).norm() / w.norm());
+      worst.update((grbd::ode::euler_top_omega(top, 0.0) - w).norm() / w.norm(), n,
+                   [&] { return describe("Theta", Theta, "w0", w); });
     }
   }
-  EXPECT_LE(worst, 1e-13);
+  EXPECT_LE(worst.value(), 1e-13) << worst;
 }
 
 // Reference: the torque-free body keeps 2E = ωᵀΘω and L² = |Θω|², and ω has the period 4K/λ;
@@ -215,25 +236,26 @@ TEST(Exercise3_4, StartsAtTheInitialAngularVelocity) {
 // two periods) and 1e-12 |ω| (periodicity).
 TEST(Exercise3_4, KeepsEnergyAndMomentumAndIsPeriodic) {
   grbd::test::Random rng(3403);
-  double worst_invariants = 0.0;
-  double worst_period = 0.0;
+  WorstCase worst_invariants;
+  WorstCase worst_period;
   const Vector3 Theta(0.7, 1.1, 2.5);
   for (const Vector3& w : branch_states(Theta, rng, 20)) {
     const EulerTop top = grbd::ode::euler_top(Theta, w);
     for (int k = 0; k < 100; ++k) {
       const double t = 0.02 * k * top.period;
       const Vector3 omega = grbd::ode::euler_top_omega(top, t);
-      worst_invariants = std::max({worst_invariants,
-                                   std::abs(two_energy(Theta, omega) / two_energy(Theta, w) - 1.0),
-                                   std::abs(momentum2(Theta, omega) / momentum2(Theta, w) - 1.0)});
-      worst_period =
-          std::max(worst_period,
-                   (grbd::ode::euler_top_omega(top, t + top.period) - omega).norm() / w.norm());
+      const auto inputs = [&] { return describe("Theta", Theta, "w0", w, "t", t); };
+      worst_invariants.update(std::abs(two_energy(Theta, omega) / two_energy(Theta, w) - 1.0),
+                              [&] { return "2E, " + inputs(); });
+      worst_invariants.update(std::abs(momentum2(Theta, omega) / momentum2(Theta, w) - 1.0),
+                              [&] { return "L², " + inputs(); });
+      worst_period.update(
+          (grbd::ode::euler_top_omega(top, t + top.period) - omega).norm() / w.norm(), inputs);
     }
     EXPECT_NEAR(grbd::ode::flip_interval(top), 0.5 * top.period, 1e-14 * top.period);
   }
-  EXPECT_LE(worst_invariants, 1e-13);
-  EXPECT_LE(worst_period, 1e-12);
+  EXPECT_LE(worst_invariants.value(), 1e-13) << worst_invariants;
+  EXPECT_LE(worst_period.value(), 1e-12) << worst_period;
 }
 
 // Reference: Euler's equations written out and integrated by CVODE (BDF, rtol 1e-12, atol 1e-14)
@@ -250,14 +272,15 @@ TEST(Exercise3_4, MatchesCvodeOnEulersEquations) {
     const RigidBody body{1.0, Theta};
     const EulerTop top = grbd::ode::euler_top(Theta, w0);
     Cvode cvode(euler_equations(body), 0.0, w0, CvodeMethod::bdf, {1e-12, 1e-14, {}});
-    double worst = 0.0;
+    WorstCase worst;
     for (int k = 1; k <= 200; ++k) {
       const double t = 0.01 * k * top.period;
-      worst =
-          std::max(worst, (Vector3(cvode.advance(t)) - grbd::ode::euler_top_omega(top, t)).norm() /
-                              w0.norm());
+      const Vector3 by_cvode = cvode.advance(t);
+      worst.update((by_cvode - grbd::ode::euler_top_omega(top, t)).norm() / w0.norm(),
+                   [&] { return describe("t", t, "CVODE ω(t)", by_cvode); });
     }
-    EXPECT_LE(worst, 2e-9) << "Θ = " << Theta.transpose() << ", ω0 = " << w0.transpose();
+    EXPECT_LE(worst.value(), 2e-9) << "Θ = " << Theta.transpose() << ", ω0 = " << w0.transpose()
+                                   << "; " << worst;
   }
 }
 
@@ -355,15 +378,17 @@ TEST(HeavyTop, NutationBoundsContainTheMotionAndAreTouched) {
     for (int k = 1; k <= 4000; ++k) u.push_back(cos_tilt(cvode.advance(2.5e-4 * k)));
     double lowest = 1.0;
     double highest = -1.0;
-    double outside = 0.0;
+    WorstCase outside;
     for (std::size_t k = 1; k + 1 < u.size(); ++k) {
-      outside = std::max({outside, bounds.u_min - u[k], u[k] - bounds.u_max});
+      const auto inputs = [&] { return describe("t", 2.5e-4 * static_cast<double>(k), "u", u[k]); };
+      outside.update(bounds.u_min - u[k], inputs);
+      outside.update(u[k] - bounds.u_max, inputs);
       const double second = u[k + 1] - 2.0 * u[k] + u[k - 1];
       const double vertex = u[k] - std::pow(u[k + 1] - u[k - 1], 2) / (8.0 * second);
       if (u[k] <= u[k - 1] && u[k] <= u[k + 1]) lowest = std::min(lowest, vertex);
       if (u[k] >= u[k - 1] && u[k] >= u[k + 1]) highest = std::max(highest, vertex);
     }
-    EXPECT_LE(outside, 1e-9) << "ω0 = " << w0.transpose();
+    EXPECT_LE(outside.value(), 1e-9) << "ω0 = " << w0.transpose() << "; " << outside;
     EXPECT_NEAR(lowest, bounds.u_min, 1e-8) << "ω0 = " << w0.transpose();
     EXPECT_NEAR(highest, bounds.u_max, 1e-8) << "ω0 = " << w0.transpose();
   }

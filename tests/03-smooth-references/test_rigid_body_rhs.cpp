@@ -24,6 +24,7 @@
 #include "grbd_test/bodies.hpp"
 #include "grbd_test/random.hpp"
 #include "grbd_test/references.hpp"
+#include "grbd_test/worst_case.hpp"
 
 namespace {
 
@@ -41,8 +42,10 @@ using grbd::kinematics::make_u;
 using grbd::kinematics::Quaternion;
 using grbd::ode::Cvode;
 using grbd::ode::CvodeMethod;
+using grbd::test::describe;
 using grbd::test::max_abs;
 using grbd::test::reference_A_IK;
+using grbd::test::WorstCase;
 
 constexpr double kEps = std::numeric_limits<double>::epsilon();
 
@@ -83,7 +86,7 @@ Eigen::VectorXd tilted_top(double theta0, const Vector3& K_omega) {
 // tolerance 1e-14 (1 + |ẏ|).
 TEST(Exercise3_1, IsTheKinematicsAndNewtonEulerEquationsWrittenOut) {
   grbd::test::Random rng(3101);
-  double worst = 0.0;
+  WorstCase worst;
   for (int n = 0; n < 5000; ++n) {
     const RigidBody body = grbd::test::random_body(rng);
     State x = grbd::test::random_state(rng);
@@ -99,9 +102,10 @@ TEST(Exercise3_1, IsTheKinematicsAndNewtonEulerEquationsWrittenOut) {
     expected << v, 0.5 * grbd::test::reference_product(p, Quaternion::pure(w)).coeffs(),
         loads.I_F / body.m,
         (loads.K_M + grbd::test::gyroscopic_torque(body, w)).cwiseQuotient(body.K_Theta);
-    worst = std::max(worst, max_abs(y_dot - expected) / (1.0 + max_abs(expected)));
+    worst.update(max_abs(y_dot - expected) / (1.0 + max_abs(expected)), n,
+                 [&] { return describe("body", body, "x", x, "loads", loads); });
   }
-  EXPECT_LE(worst, 1e-14);
+  EXPECT_LE(worst.value(), 1e-14) << worst;
 }
 
 // Reference: the torque-free body keeps E = ½ uᵀMu and I_L = A_IK Θω exactly, and S moves
@@ -114,24 +118,25 @@ TEST(Exercise3_1, CvodeConservesEnergyAndAngularMomentumOverManyPeriods) {
   const Vector3 L0 = reference_A_IK(x0.q) * kBody.K_Theta.cwiseProduct(x0.u.tail<3>());
   Cvode cvode(grbd::ode::free_body(kBody), 0.0, grbd::ode::pack(x0), CvodeMethod::bdf,
               {1e-12, 1e-14, {}});
-  double worst_E = 0.0;
-  double worst_L = 0.0;
-  double worst_r = 0.0;
-  double worst_v = 0.0;
+  WorstCase worst_E;
+  WorstCase worst_L;
+  WorstCase worst_r;
+  WorstCase worst_v;
   for (int k = 1; k <= 400; ++k) {
     const double t = 0.1575 * k;
     const Eigen::VectorXd y = cvode.advance(t);
     const State x = grbd::ode::unpack(y);
     const Vector3 L = A_IK_at(y, 3) * kBody.K_Theta.cwiseProduct(x.u.tail<3>());
-    worst_E = std::max(worst_E, std::abs(grbd::body::kinetic_energy(kBody, x.u) - E0) / E0);
-    worst_L = std::max(worst_L, (L - L0).norm() / L0.norm());
-    worst_r = std::max(worst_r, (x.q.head<3>() - x0.q.head<3>() - t * x0.u.head<3>()).norm());
-    worst_v = std::max(worst_v, (x.u.head<3>() - x0.u.head<3>()).norm());
+    const auto inputs = [&] { return describe("t", t, "x(t)", x); };
+    worst_E.update(std::abs(grbd::body::kinetic_energy(kBody, x.u) - E0) / E0, inputs);
+    worst_L.update((L - L0).norm() / L0.norm(), inputs);
+    worst_r.update((x.q.head<3>() - x0.q.head<3>() - t * x0.u.head<3>()).norm(), inputs);
+    worst_v.update((x.u.head<3>() - x0.u.head<3>()).norm(), inputs);
   }
-  EXPECT_LE(worst_E, 1e-8);
-  EXPECT_LE(worst_L, 1e-8);
-  EXPECT_LE(worst_r, 1e-10);
-  EXPECT_LE(worst_v, 1e-12);
+  EXPECT_LE(worst_E.value(), 1e-8) << worst_E;
+  EXPECT_LE(worst_L.value(), 1e-8) << worst_L;
+  EXPECT_LE(worst_r.value(), 1e-10) << worst_r;
+  EXPECT_LE(worst_v.value(), 1e-12) << worst_v;
 }
 
 // Reference: under a constant force and torque-free rotation, S follows the parabola
@@ -142,15 +147,18 @@ TEST(Exercise3_1, ConstantForceMovesTheCentreOfMassOnTheParabola) {
   const Vector3 g(0.0, 0.0, -9.81);
   Cvode cvode(grbd::ode::free_body(kBody, Loads{kBody.m * g, Vector3::Zero()}), 0.0,
               grbd::ode::pack(x0), CvodeMethod::bdf, {1e-10, 1e-12, {}});
-  double worst = 0.0;
+  WorstCase worst;
   for (int k = 1; k <= 30; ++k) {
     const double t = 0.1 * k;
     const State x = grbd::ode::unpack(cvode.advance(t));
     const Vector3 r = x0.q.head<3>() + t * x0.u.head<3>() + 0.5 * t * t * g;
     const Vector3 v = x0.u.head<3>() + t * g;
-    worst = std::max({worst, (x.q.head<3>() - r).norm(), (x.u.head<3>() - v).norm()});
+    worst.update((x.q.head<3>() - r).norm(),
+                 [&] { return "r, " + describe("t", t, "x(t)", x, "r exact", r); });
+    worst.update((x.u.head<3>() - v).norm(),
+                 [&] { return "v, " + describe("t", t, "x(t)", x, "v exact", v); });
   }
-  EXPECT_LE(worst, 1e-8);
+  EXPECT_LE(worst.value(), 1e-8) << worst;
 }
 
 // ----------------------------------------------------------------------------------------------
@@ -164,8 +172,8 @@ TEST(Exercise3_1, ConstantForceMovesTheCentreOfMassOnTheParabola) {
 // (1/|p| − 1) p (the two forms round differently by a few ulps of max(1, |p|)).
 TEST(Exercise3_2, CorrectionIsTheRadialProjectionOntoTheUnitSphere) {
   grbd::test::Random rng(3201);
-  double worst_norm = 0.0;
-  double worst_correction = 0.0;
+  WorstCase worst_norm;
+  WorstCase worst_correction;
   bool others_zero = true;
   for (int n = 0; n < 3000; ++n) {
     const Eigen::Index size = 4 + n % 17;
@@ -176,16 +184,16 @@ TEST(Exercise3_2, CorrectionIsTheRadialProjectionOntoTheUnitSphere) {
     Eigen::VectorXd correction = Eigen::VectorXd::Constant(size, 123.0);  // must be overwritten
     grbd::ode::quaternion_projection(offset, y, correction);
     const double norm = p.norm();
-    worst_norm = std::max(worst_norm, std::abs((y + correction).segment<4>(offset).norm() - 1.0));
-    worst_correction =
-        std::max(worst_correction,
-                 max_abs(Vector4(correction.segment<4>(offset)) - (1.0 / norm - 1.0) * p) / norm);
+    const auto inputs = [&] { return describe("offset", offset, "y", y); };
+    worst_norm.update(std::abs((y + correction).segment<4>(offset).norm() - 1.0), n, inputs);
+    worst_correction.update(
+        max_abs(Vector4(correction.segment<4>(offset)) - (1.0 / norm - 1.0) * p) / norm, n, inputs);
     for (Eigen::Index i = 0; i < size; ++i) {
       if ((i < offset || i >= offset + 4) && correction[i] != 0.0) others_zero = false;
     }
   }
-  EXPECT_LE(worst_norm, 4.0 * kEps);
-  EXPECT_LE(worst_correction, 16.0 * kEps);
+  EXPECT_LE(worst_norm.value(), 4.0 * kEps) << worst_norm;
+  EXPECT_LE(worst_correction.value(), 16.0 * kEps) << worst_correction;
   EXPECT_TRUE(others_zero) << "entries outside the quaternion must be exactly zero";
 }
 
@@ -199,15 +207,16 @@ TEST(Exercise3_2, KeepsTheUnitQuaternionWhereCvodeAloneDrifts) {
   Cvode projected(grbd::ode::heavy_top(kTop), 0.0, y0, CvodeMethod::bdf, {1e-6, 1e-8, {}});
   projected.set_projection(grbd::ode::quaternion_projection_at(0));
   double drift_free = 0.0;
-  double drift_projected = 0.0;
+  WorstCase drift_projected;
   for (int k = 1; k <= 200; ++k) {
     const double t = 0.01 * k;
     drift_free = std::max(drift_free, std::abs(free.advance(t).head<4>().norm() - 1.0));
-    drift_projected =
-        std::max(drift_projected, std::abs(projected.advance(t).head<4>().norm() - 1.0));
+    const Eigen::VectorXd y = projected.advance(t);
+    drift_projected.update(std::abs(y.head<4>().norm() - 1.0),
+                           [&] { return describe("t", t, "y(t)", y); });
   }
   EXPECT_GE(drift_free, 1e-7);
-  EXPECT_LE(drift_projected, 4.0 * kEps);
+  EXPECT_LE(drift_projected.value(), 4.0 * kEps) << drift_projected;
   const grbd::ode::Statistics s = projected.statistics();
   EXPECT_GE(s.projections, s.steps);
 }
@@ -270,13 +279,14 @@ TEST(RigidBodyRhs, PrescribedTorqueIsAppliedAtTheTimeOfEachEvaluation) {
   Cvode cvode(grbd::ode::prescribed_torque_body(
                   sphere, [&](double t) -> Vector3 { return 0.4 * a * std::cos(t); }),
               0.0, grbd::ode::pack(x0), CvodeMethod::bdf, {1e-10, 1e-12, {}});
-  double worst = 0.0;
+  WorstCase worst;
   for (int k = 1; k <= 50; ++k) {
     const double t = 0.1 * k;
     const Eigen::VectorXd y = cvode.advance(t);
-    worst = std::max(worst, (Vector3(y.tail<3>()) - (omega0 + a * std::sin(t))).norm());
+    worst.update((Vector3(y.tail<3>()) - (omega0 + a * std::sin(t))).norm(),
+                 [&] { return describe("t", t, "y(t)", y); });
   }
-  EXPECT_LE(worst, 1e-8);
+  EXPECT_LE(worst.value(), 1e-8) << worst;
 }
 
 // Reference: the heavy top about its fixed point O keeps the energy
@@ -297,12 +307,16 @@ TEST(HeavyTop, CvodeConservesEnergyAndTheVerticalAndAxialAngularMomenta) {
   const Vector3 start = invariants(y0);
   Cvode cvode(grbd::ode::heavy_top(kTop), 0.0, y0, CvodeMethod::bdf, {1e-12, 1e-14, {}});
   cvode.set_projection(grbd::ode::quaternion_projection_at(0));
-  Vector3 worst = Vector3::Zero();
+  WorstCase worst[3];
   for (int k = 1; k <= 100; ++k) {
-    worst = worst.cwiseMax(
-        (invariants(cvode.advance(0.01 * k)) - start).cwiseAbs().cwiseQuotient(start.cwiseAbs()));
+    const double t = 0.01 * k;
+    const Eigen::VectorXd y = cvode.advance(t);
+    const Vector3 drift = (invariants(y) - start).cwiseAbs().cwiseQuotient(start.cwiseAbs());
+    for (int i = 0; i < 3; ++i) {
+      worst[i].update(drift[i], [&] { return describe("t", t, "y(t)", y); });
+    }
   }
-  EXPECT_LE(worst[0], 1e-8) << "energy";
-  EXPECT_LE(worst[1], 1e-8) << "vertical angular momentum";
-  EXPECT_LE(worst[2], 1e-8) << "axial angular momentum";
+  EXPECT_LE(worst[0].value(), 1e-8) << "energy; " << worst[0];
+  EXPECT_LE(worst[1].value(), 1e-8) << "vertical angular momentum; " << worst[1];
+  EXPECT_LE(worst[2].value(), 1e-8) << "axial angular momentum; " << worst[2];
 }

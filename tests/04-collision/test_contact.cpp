@@ -20,6 +20,7 @@
 #include "grbd_test/bodies.hpp"
 #include "grbd_test/random.hpp"
 #include "grbd_test/references.hpp"
+#include "grbd_test/worst_case.hpp"
 
 namespace {
 
@@ -30,8 +31,10 @@ using grbd::Vector7;
 using grbd::body::State;
 using grbd::collision::ContactGeometry;
 using grbd::collision::ContactJacobian;
+using grbd::test::describe;
 using grbd::test::exact_motion;
 using grbd::test::reference_A_IK;
+using grbd::test::WorstCase;
 using Basis = Eigen::Matrix<double, 3, 2>;
 
 constexpr double kEps = std::numeric_limits<double>::epsilon();
@@ -40,17 +43,29 @@ constexpr double kEps = std::numeric_limits<double>::epsilon();
 constexpr double kDelta = 1e-5;
 constexpr double kDifferenceTol = 1e-7;
 
-// The largest deviation of (n, t1, t2) from an orthonormal right-handed frame.
-double frame_error(const Vector3& n, const Basis& T) {
+// The largest deviation of (n, t1, t2) from an orthonormal right-handed frame (value()), and
+// which property deviates most (input()); a NaN counts as the largest deviation.
+WorstCase frame_error(const Vector3& n, const Basis& T) {
   const Vector3 t1(T.col(0));
   const Vector3 t2(T.col(1));
-  double e = std::abs(t1.norm() - 1.0);
-  e = std::max(e, std::abs(t2.norm() - 1.0));
-  e = std::max(e, std::abs(t1.dot(n)));
-  e = std::max(e, std::abs(t2.dot(n)));
-  e = std::max(e, std::abs(t1.dot(t2)));
-  e = std::max(e, (n.cross(t1) - t2).cwiseAbs().maxCoeff());
+  WorstCase e;
+  e.update(std::abs(t1.norm() - 1.0), [] { return "|t1| = 1"; });
+  e.update(std::abs(t2.norm() - 1.0), [] { return "|t2| = 1"; });
+  e.update(std::abs(t1.dot(n)), [] { return "t1·n = 0"; });
+  e.update(std::abs(t2.dot(n)), [] { return "t2·n = 0"; });
+  e.update(std::abs(t1.dot(t2)), [] { return "t1·t2 = 0"; });
+  e.update((n.cross(t1) - t2).cwiseAbs().maxCoeff(), [] { return "n × t1 = t2"; });
   return e;
+}
+
+// Records the frame error of tangent_basis(n) in `worst`, for sample number `sample` (none if
+// negative).
+void update_frame_error(WorstCase& worst, const Vector3& n, int sample = -1) {
+  const Basis T = grbd::collision::tangent_basis(n);
+  const WorstCase frame = frame_error(n, T);
+  worst.update(frame.value(), sample, [&] {
+    return describe("n", n, "t1", T.col(0), "t2", T.col(1), "failing", frame.input());
+  });
 }
 
 grbd::kinematics::Quaternion orientation(const Vector7& q) {
@@ -97,36 +112,35 @@ Eigen::Vector2d slip_by_differences(const State& a, const State& b, const Contac
 // tolerance 4 ε.
 TEST(Exercise4_4, IsOrthonormalAndRightHanded) {
   grbd::test::Random rng(4401);
-  double worst = 0.0;
+  WorstCase worst;
   for (int k = 0; k < 10000; ++k) {
     const Vector3 n = rng.unit_vector3();
-    worst = std::max(worst, frame_error(n, grbd::collision::tangent_basis(n)));
+    update_frame_error(worst, n, k);
   }
   for (int i = 0; i < 3; ++i) {
     for (const double s : {1.0, -1.0}) {
       const Vector3 n = s * Vector3::Unit(i);
-      worst = std::max(worst, frame_error(n, grbd::collision::tangent_basis(n)));
+      update_frame_error(worst, n);
     }
   }
-  EXPECT_LE(worst, 4 * kEps);
+  EXPECT_LE(worst.value(), 4 * kEps) << worst;
 }
 
 // Reference: n close to the singular point −e_z, at angles 1e-3 … 1e-15 and 0 from it: still
 // orthonormal to 4 ε (Frisvad's 1/(1 + n_z) would lose every digit here).
 TEST(Exercise4_4, IsAccurateNearTheSingularPoint) {
   grbd::test::Random rng(4402);
-  double worst = 0.0;
+  WorstCase worst;
   for (double angle = 1e-3; angle > 1e-16; angle /= 10.0) {
     for (int k = 0; k < 20; ++k) {
       const double phi = rng.uniform(0.0, 2.0 * M_PI);
       const Vector3 n(std::sin(angle) * std::cos(phi), std::sin(angle) * std::sin(phi),
                       -std::cos(angle));
-      worst = std::max(worst, frame_error(n, grbd::collision::tangent_basis(n)));
+      update_frame_error(worst, n);
     }
   }
-  worst = std::max(
-      worst, frame_error(-Vector3::UnitZ(), grbd::collision::tangent_basis(-Vector3::UnitZ())));
-  EXPECT_LE(worst, 4 * kEps);
+  update_frame_error(worst, -Vector3::UnitZ());
+  EXPECT_LE(worst.value(), 4 * kEps) << worst;
 }
 
 // Reference: a perturbation of n by δ = 1e-7 (renormalised) changes t1, t2 by at most 100 |Δn|
@@ -135,16 +149,17 @@ TEST(Exercise4_4, IsAccurateNearTheSingularPoint) {
 TEST(Exercise4_4, IsContinuousAwayFromTheSingularPoint) {
   grbd::test::Random rng(4403);
   constexpr double kStep = 1e-7;
-  double worst = 0.0;
+  WorstCase worst;
   for (int k = 0; k < 20000; ++k) {
     Vector3 n = rng.unit_vector3();
     if (k % 4 == 0) n = Vector3(n.x(), n.y(), 1e-9 * n.z()).normalized();  // at the equator
     if (n.z() < -0.9) continue;
     const Vector3 m = (n + kStep * rng.unit_vector3()).normalized();
     const Basis change = grbd::collision::tangent_basis(m) - grbd::collision::tangent_basis(n);
-    worst = std::max(worst, change.cwiseAbs().maxCoeff() / (m - n).norm());
+    worst.update(change.cwiseAbs().maxCoeff() / (m - n).norm(), k,
+                 [&] { return describe("n", n, "m", m); });
   }
-  EXPECT_LE(worst, 100.0);
+  EXPECT_LE(worst.value(), 100.0) << worst;
 }
 
 // ----------------------------------------------------------------------------------------------
@@ -178,7 +193,7 @@ TEST(Exercise4_5, ColumnsAreDirectionAndMomentArm) {
 // points (γ_T). Tolerance kDifferenceTol.
 TEST(Exercise4_5, NormalVelocityIsTheGapRateOfTwoMovingSpheres) {
   grbd::test::Random rng(4502);
-  double worst_normal = 0.0, worst_slip = 0.0;
+  WorstCase worst_normal, worst_slip;
   for (int k = 0; k < 500; ++k) {
     const State a = grbd::test::random_state(rng);
     State b = grbd::test::random_state(rng);
@@ -192,13 +207,14 @@ TEST(Exercise4_5, NormalVelocityIsTheGapRateOfTwoMovingSpheres) {
     const ContactGeometry g =
         grbd::collision::sphere_sphere(a.q.head<3>(), r_a, b.q.head<3>(), r_b);
     const Vector3 gamma = contact_velocity(a, b, g);
-    worst_normal =
-        std::max(worst_normal, std::abs(gamma[0] - (gap(kDelta) - gap(-kDelta)) / (2 * kDelta)));
-    worst_slip = std::max(worst_slip,
-                          (gamma.tail<2>() - slip_by_differences(a, b, g)).cwiseAbs().maxCoeff());
+    const auto inputs = [&] { return describe("a", a, "b", b, "r_a", r_a, "r_b", r_b); };
+    worst_normal.update(std::abs(gamma[0] - (gap(kDelta) - gap(-kDelta)) / (2 * kDelta)), k,
+                        inputs);
+    worst_slip.update((gamma.tail<2>() - slip_by_differences(a, b, g)).cwiseAbs().maxCoeff(), k,
+                      inputs);
   }
-  EXPECT_LE(worst_normal, kDifferenceTol);
-  EXPECT_LE(worst_slip, kDifferenceTol);
+  EXPECT_LE(worst_normal.value(), kDifferenceTol) << worst_normal;
+  EXPECT_LE(worst_slip.value(), kDifferenceTol) << worst_slip;
 }
 
 // Reference: a rotating sphere above the plane z = 0.25: γ_N = ġ_N by central differences, and
@@ -207,7 +223,7 @@ TEST(Exercise4_5, NormalVelocityIsTheGapRateAboveAHalfSpace) {
   grbd::test::Random rng(4503);
   const grbd::collision::HalfSpace plane{Vector3(0.0, 0.6, 0.8), 0.25};
   const State ground{grbd::kinematics::make_q(Vector3::Zero(), {}), Vector6::Zero()};
-  double worst_normal = 0.0, worst_slip = 0.0;
+  WorstCase worst_normal, worst_slip;
   for (int k = 0; k < 500; ++k) {
     const State a = grbd::test::random_state(rng);
     const double r = rng.uniform(0.1, 0.5);
@@ -216,13 +232,14 @@ TEST(Exercise4_5, NormalVelocityIsTheGapRateAboveAHalfSpace) {
     };
     const ContactGeometry g = grbd::collision::sphere_half_space(a.q.head<3>(), r, plane);
     const Vector3 gamma = contact_velocity(a, ground, g);
-    worst_normal =
-        std::max(worst_normal, std::abs(gamma[0] - (gap(kDelta) - gap(-kDelta)) / (2 * kDelta)));
-    worst_slip = std::max(
-        worst_slip, (gamma.tail<2>() - slip_by_differences(a, ground, g)).cwiseAbs().maxCoeff());
+    const auto inputs = [&] { return describe("a", a, "r", r); };
+    worst_normal.update(std::abs(gamma[0] - (gap(kDelta) - gap(-kDelta)) / (2 * kDelta)), k,
+                        inputs);
+    worst_slip.update((gamma.tail<2>() - slip_by_differences(a, ground, g)).cwiseAbs().maxCoeff(),
+                      k, inputs);
   }
-  EXPECT_LE(worst_normal, kDifferenceTol);
-  EXPECT_LE(worst_slip, kDifferenceTol);
+  EXPECT_LE(worst_normal.value(), kDifferenceTol) << worst_normal;
+  EXPECT_LE(worst_slip.value(), kDifferenceTol) << worst_slip;
 }
 
 // Reference: a sphere (a) in front of the +z face of a rotating, translating box (b) [−1, 1]³:
@@ -230,7 +247,7 @@ TEST(Exercise4_5, NormalVelocityIsTheGapRateAboveAHalfSpace) {
 TEST(Exercise4_5, NormalVelocityIsTheGapRateAgainstARotatingBox) {
   grbd::test::Random rng(4504);
   const grbd::collision::Box box{Vector3::Ones()};
-  double worst_normal = 0.0, worst_slip = 0.0;
+  WorstCase worst_normal, worst_slip;
   for (int k = 0; k < 500; ++k) {
     const State b = grbd::test::random_state(rng);
     State a = grbd::test::random_state(rng);
@@ -246,14 +263,15 @@ TEST(Exercise4_5, NormalVelocityIsTheGapRateAgainstARotatingBox) {
     const ContactGeometry g = geometry(0.0);
     ASSERT_EQ(g.feature_b, grbd::collision::face_feature(5));
     const Vector3 gamma = contact_velocity(a, b, g);
-    worst_normal = std::max(
-        worst_normal,
-        std::abs(gamma[0] - (geometry(kDelta).g_N - geometry(-kDelta).g_N) / (2 * kDelta)));
-    worst_slip = std::max(worst_slip,
-                          (gamma.tail<2>() - slip_by_differences(a, b, g)).cwiseAbs().maxCoeff());
+    const auto inputs = [&] { return describe("a", a, "b", b, "r", r, "K_x", K_x); };
+    worst_normal.update(
+        std::abs(gamma[0] - (geometry(kDelta).g_N - geometry(-kDelta).g_N) / (2 * kDelta)), k,
+        inputs);
+    worst_slip.update((gamma.tail<2>() - slip_by_differences(a, b, g)).cwiseAbs().maxCoeff(), k,
+                      inputs);
   }
-  EXPECT_LE(worst_normal, kDifferenceTol);
-  EXPECT_LE(worst_slip, kDifferenceTol);
+  EXPECT_LE(worst_normal.value(), kDifferenceTol) << worst_normal;
+  EXPECT_LE(worst_slip.value(), kDifferenceTol) << worst_slip;
 }
 
 // ----------------------------------------------------------------------------------------------

@@ -18,6 +18,7 @@
 
 #include "grbd/collision/narrow_phase.hpp"
 #include "grbd_test/random.hpp"
+#include "grbd_test/worst_case.hpp"
 
 namespace {
 
@@ -29,6 +30,8 @@ using grbd::collision::ContactGeometry;
 using grbd::collision::HalfSpace;
 using grbd::collision::Placement;
 using grbd::collision::TriangleFeature;
+using grbd::test::describe;
+using grbd::test::WorstCase;
 
 constexpr double kEps = std::numeric_limits<double>::epsilon();
 
@@ -161,12 +164,13 @@ TEST(Exercise4_2, MatchesEigenHyperplane) {
 // than the answer by more than 1e-12.
 TEST(Exercise4_3, MatchesProjectionOntoEachFeatureAndDenseSampling) {
   grbd::test::Random rng(4301);
-  double worst = 0.0;
+  WorstCase worst;
   for (int k = 0; k < 2000; ++k) {
     const Vector3 a = rng.vector3(), b = rng.vector3(), c = rng.vector3();
     const Vector3 x = rng.vector3(-2.0, 2.0);
     const Vector3 p = grbd::collision::closest_point_on_triangle(x, a, b, c).point;
-    worst = std::max(worst, max_diff(p, reference_closest(x, a, b, c)));
+    worst.update(max_diff(p, reference_closest(x, a, b, c)), k,
+                 [&] { return describe("x", x, "a", a, "b", b, "c", c, "found", p); });
     if (k < 100) {
       const double d = (p - x).norm();
       constexpr int kSamples = 60;
@@ -178,7 +182,7 @@ TEST(Exercise4_3, MatchesProjectionOntoEachFeatureAndDenseSampling) {
       }
     }
   }
-  EXPECT_LE(worst, 1e-12);
+  EXPECT_LE(worst.value(), 1e-12) << worst;
 }
 
 // Reference: by hand, for the triangle (0, 0, 0), (2, 0, 0), (0, 2, 0): points exactly on the

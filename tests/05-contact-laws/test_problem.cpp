@@ -36,6 +36,7 @@
 #include "grbd/kinematics/rigid_motion.hpp"
 #include "grbd_test/random.hpp"
 #include "grbd_test/references.hpp"
+#include "grbd_test/worst_case.hpp"
 
 namespace {
 
@@ -67,10 +68,44 @@ using grbd::contact::validate;
 using grbd::contact::velocities_from_percussions;
 using grbd::kinematics::make_q;
 using grbd::kinematics::make_u;
+using grbd::test::describe;
 using grbd::test::Random;
 using grbd::test::reference_A_IK;
+using grbd::test::WorstCase;
 using MatrixX = Eigen::MatrixXd;
 using VectorX = Eigen::VectorXd;
+
+}  // namespace
+
+// describe() of the inputs of a contact problem, for the failure messages of the worst cases.
+namespace grbd::test {
+
+template <>
+struct Describer<contact::InverseMass> {
+  static void put(std::ostream& os, const contact::InverseMass& m) {
+    os << "(" << describe("inv_m", m.inv_m, "K_Theta_inv", m.K_Theta_inv) << ")";
+  }
+};
+
+template <>
+struct Describer<contact::ContactConstraint> {
+  static void put(std::ostream& os, const contact::ContactConstraint& c) {
+    os << "(" << describe("body_a", c.body_a, "body_b", c.body_b, "W_a", c.W_a, "W_b", c.W_b,
+                          "gamma_A", c.gamma_A, "mu", c.mu, "eps_N", c.eps_N, "eps_T", c.eps_T)
+       << ")";
+  }
+};
+
+template <>
+struct Describer<contact::ContactProblem> {
+  static void put(std::ostream& os, const contact::ContactProblem& p) {
+    os << "(" << describe("M_inv", p.M_inv, "u_free", p.u_free, "contacts", p.contacts) << ")";
+  }
+};
+
+}  // namespace grbd::test
+
+namespace {
 
 constexpr double kEps = std::numeric_limits<double>::epsilon();
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
@@ -318,15 +353,19 @@ ContactProblem valid_problem() {
 // velocities and restitutions ε_N ∈ [0, 1], ε_T ∈ [−1, 1]; tolerance 4 ε (|γ_E| + |γ_A|).
 TEST(Exercise5_4, IsTheEndVelocityPlusTheRestitutedStartVelocity) {
   Random rng(5401);
-  double worst = 0.0;
+  WorstCase worst;
   for (int k = 0; k < 10000; ++k) {
     const Vector3 gamma_E = rng.vector3(-5, 5), gamma_A = rng.vector3(-5, 5);
     const double eps_N = rng.uniform(0.0, 1.0), eps_T = rng.uniform(-1.0, 1.0);
     const Vector3 expected = gamma_E + Vector3(eps_N, eps_T, eps_T).asDiagonal() * gamma_A;
-    worst = std::max(worst, (impact_velocity(gamma_E, gamma_A, eps_N, eps_T) - expected).norm() /
-                                (gamma_E.norm() + gamma_A.norm()));
+    worst.update(
+        (impact_velocity(gamma_E, gamma_A, eps_N, eps_T) - expected).norm() /
+            (gamma_E.norm() + gamma_A.norm()),
+        k, [&] {
+          return describe("gamma_E", gamma_E, "gamma_A", gamma_A, "eps_N", eps_N, "eps_T", eps_T);
+        });
   }
-  EXPECT_LE(worst, 4 * kEps);
+  EXPECT_LE(worst.value(), 4 * kEps) << worst;
 }
 
 // Reference: Newton's law. For a closing contact γ_A = (−v, s) the law ξ = 0 of a persisting
@@ -361,7 +400,7 @@ TEST(Exercise5_4, ZeroImpactVelocityIsNewtonsLaw) {
 // orientations, lever arms and positive inverse principal moments. Tolerance kProductTol ‖G‖.
 TEST(Exercise5_5, MatchesTheDenseProduct) {
   Random rng(5501);
-  double worst = 0.0;
+  WorstCase worst;
   for (int k = 0; k < 200; ++k) {
     const ContactProblem p = random_problem(rng, 3, {{2, 0}, {1, kStatic}, {kStatic, 2}, {0, 1}});
     const MatrixX W = dense_W(p);
@@ -370,11 +409,13 @@ TEST(Exercise5_5, MatchesTheDenseProduct) {
       const Matrix3 expected =
           G.block<3, 3>(3 * static_cast<Eigen::Index>(i), 3 * static_cast<Eigen::Index>(i));
       const Matrix3 block = delassus_block(p.contacts[i], p.M_inv);
-      worst = std::max(worst, (block - expected).norm() / expected.norm());
+      worst.update((block - expected).norm() / expected.norm(), k, [&] {
+        return describe("contact", i, "c", p.contacts[i], "M_inv", p.M_inv);
+      });
     }
   }
-  RecordProperty("worst_relative_error", grbd::format_number(worst));
-  EXPECT_LE(worst, kProductTol);
+  RecordProperty("worst_relative_error", grbd::format_number(worst.value()));
+  EXPECT_LE(worst.value(), kProductTol) << worst;
 }
 
 // Reference: G is symmetric (to kProductTol ‖G‖) and, because the translational part of W is the
@@ -527,7 +568,7 @@ TEST(Exercise5_6, RefusesANonPositiveDiagonal) {
 // kProductTol relative.
 TEST(Exercise5_7, OneUpdateMovesTheBodiesByMInvWDeltaLambda) {
   Random rng(5701);
-  double worst = 0.0;
+  WorstCase worst;
   for (int k = 0; k < 300; ++k) {
     const ContactProblem p = random_problem(rng, 3, {{2, 0}, {kStatic, 1}, {1, kStatic}});
     for (const ContactConstraint& c : p.contacts) {
@@ -545,8 +586,12 @@ TEST(Exercise5_7, OneUpdateMovesTheBodiesByMInvWDeltaLambda) {
             gamma + Vector3(c.eps_N, c.eps_T, c.eps_T).cwiseProduct(c.gamma_A);
         const Vector3 expected = reference_update(lambda0, expected_xi, r, form, c.mu);
         const double size = 1.0 + lambda0.norm() + expected_xi.norm();
-        worst = std::max(worst, (xi - expected_xi).norm() / size);
-        worst = std::max(worst, (lambda - expected).norm() / size);
+        const auto inputs = [&] {
+          return describe("form", name(form), "lambda0", lambda0, "r_N", r.r_N, "r_T", r.r_T, "c",
+                          c, "M_inv", p.M_inv, "u_free", p.u_free);
+        };
+        worst.update((xi - expected_xi).norm() / size, k, [&] { return "ξ, " + inputs(); });
+        worst.update((lambda - expected).norm() / size, k, [&] { return "λ⁺, " + inputs(); });
         for (int b = 0; b < 3; ++b) {
           Vector6 expected_u = p.u_free[b];
           if (b == c.body_a) expected_u += dense(p.M_inv[b]) * c.W_a * (lambda - lambda0);
@@ -555,13 +600,14 @@ TEST(Exercise5_7, OneUpdateMovesTheBodiesByMInvWDeltaLambda) {
             ASSERT_EQ(u[b], p.u_free[b]) << "body " << b << " is not part of the contact";
           }
           const double u_size = 1.0 + p.u_free[b].norm() + (expected_u - p.u_free[b]).norm();
-          worst = std::max(worst, (u[b] - expected_u).norm() / u_size);
+          worst.update((u[b] - expected_u).norm() / u_size, k,
+                       [&] { return "u of body " + std::to_string(b) + ", " + inputs(); });
         }
       }
     }
   }
-  RecordProperty("worst_relative_error", grbd::format_number(worst));
-  EXPECT_LE(worst, kProductTol);
+  RecordProperty("worst_relative_error", grbd::format_number(worst.value()));
+  EXPECT_LE(worst.value(), kProductTol) << worst;
 }
 
 // Reference: a homogeneous sphere resting on the ground, with the gravity impulse of one step in
@@ -601,7 +647,7 @@ TEST(Exercise5_7, SphereSticksOrSlidesOnTheGround) {
   Random rng(5703);
   const double gh = 9.81 * 1e-2;
   int sticking = 0, sliding = 0;
-  double worst = 0.0;
+  WorstCase worst;
   for (int k = 0; k < 60; ++k) {
     const double mu = rng.uniform(0.1, 1.0);
     const Ball ball0{rng.uniform(0.1, 5.0), rng.uniform(0.05, 2.0), random_frame(rng), true,
@@ -640,14 +686,15 @@ TEST(Exercise5_7, SphereSticksOrSlidesOnTheGround) {
           const double error_u = std::max((ball.v(u[0]) - v_end).norm(),
                                           (ball.omega(u[0]) - omega_end).norm() * ball.R) /
                                  speed;
-          worst = std::max({worst, error_lambda, error_u});
+          worst.update(error_lambda, k, [&] { return "λ, " + what; });
+          worst.update(error_u, k, [&] { return "u, " + what; });
           EXPECT_LE(error_lambda, kSolutionTol) << what << ": lambda = " << lambda.transpose();
           EXPECT_LE(error_u, kSolutionTol) << what << ": u = " << u[0].transpose();
         }
       }
     }
   }
-  RecordProperty("worst_relative_error", grbd::format_number(worst));
+  RecordProperty("worst_relative_error", grbd::format_number(worst.value()));
   EXPECT_GT(sticking, 15);
   EXPECT_GT(sliding, 15);
 }
@@ -736,7 +783,7 @@ TEST(Exercise5_7, BallBouncesWithRestitution) {
 // r from the dense G.
 TEST(Exercise5_7, TwoBodyContactConservesMomentum) {
   Random rng(5706);
-  double worst_linear = 0.0, worst_angular = 0.0;
+  WorstCase worst_linear, worst_angular;
   for (int k = 0; k < 100; ++k) {
     const Vector3 P = rng.vector3();
     const Vector3 r_a = P + rng.uniform(0.2, 1.0) * rng.unit_vector3();
@@ -772,23 +819,28 @@ TEST(Exercise5_7, TwoBodyContactConservesMomentum) {
       // make the contact close: shift body a's velocity along −n until γ_N = −1
       const double gamma_N = (c.W_a.transpose() * u[1] - c.W_b.transpose() * u[0])(0);
       u[1].head<3>() -= (gamma_N + 1.0) * frame.col(0);
+      const std::vector<Vector6> u0 = u;
       const Vector6 h0 = momentum(u);
       Vector3 lambda = Vector3::Zero();
       for (int i = 0; i < 100; ++i) {
         sor_contact_update(c, r, form, M_inv, u, lambda);
         const Vector6 h = momentum(u);
         const double size = 1.0 + h0.norm();
-        worst_linear = std::max(worst_linear, (h - h0).head<3>().norm() / size);
-        worst_angular = std::max(worst_angular, (h - h0).tail<3>().norm() / size);
+        const auto inputs = [&] {
+          return describe("form", name(form), "update", i, "r_a", r_a, "r_b", r_b, "A_a", A_a,
+                          "A_b", A_b, "M_inv", M_inv, "c", c, "u0", u0);
+        };
+        worst_linear.update((h - h0).head<3>().norm() / size, k, inputs);
+        worst_angular.update((h - h0).tail<3>().norm() / size, k, inputs);
         ASSERT_LE(lambda.tail<2>().norm(), c.mu * lambda(0) + 1e-14) << name(form);
       }
       EXPECT_GT(lambda(0), 0.0) << name(form);
     }
   }
-  RecordProperty("worst_linear_momentum", grbd::format_number(worst_linear));
-  RecordProperty("worst_angular_momentum", grbd::format_number(worst_angular));
-  EXPECT_LE(worst_linear, kSolutionTol);
-  EXPECT_LE(worst_angular, kSolutionTol);
+  RecordProperty("worst_linear_momentum", grbd::format_number(worst_linear.value()));
+  RecordProperty("worst_angular_momentum", grbd::format_number(worst_angular.value()));
+  EXPECT_LE(worst_linear.value(), kSolutionTol) << worst_linear;
+  EXPECT_LE(worst_angular.value(), kSolutionTol) << worst_angular;
 }
 
 // ----------------------------------------------------------------------------------------------
@@ -1066,16 +1118,17 @@ TEST(ContactProblemValidation, RefusesKeysOfTheWrongLength) {
 // static contacts and random Λ; a Λ of the wrong length is refused.
 TEST(ContactVelocities, VelocitiesFromPercussionsAreTheDenseProduct) {
   Random rng(5902);
-  double worst = 0.0;
+  WorstCase worst;
   for (int k = 0; k < 100; ++k) {
     const ContactProblem p = random_problem(rng, 3, {{2, 0}, {1, kStatic}, {kStatic, 2}, {0, 1}});
     std::vector<Vector3> lambda;
     for (std::size_t i = 0; i < p.contacts.size(); ++i) lambda.push_back(rng.vector3(-1, 2));
     const VectorX expected = stack(p.u_free) + dense_M_inv(p) * dense_W(p) * stack(lambda);
     const VectorX u = stack(velocities_from_percussions(p, lambda));
-    worst = std::max(worst, (u - expected).norm() / expected.norm());
+    worst.update((u - expected).norm() / expected.norm(), k,
+                 [&] { return describe("problem", p, "lambda", lambda); });
   }
-  EXPECT_LE(worst, kProductTol);
+  EXPECT_LE(worst.value(), kProductTol) << worst;
   const ContactProblem p = random_problem(rng, 2, {{0, 1}, {1, kStatic}});
   EXPECT_THROW(velocities_from_percussions(p, std::vector<Vector3>(3, Vector3::Zero())),
                grbd::InvalidArgument);
@@ -1085,21 +1138,23 @@ TEST(ContactVelocities, VelocitiesFromPercussionsAreTheDenseProduct) {
 // ξ(u) − ξ(u_free) = (WᵀM⁻¹W)Λ; velocities of the wrong length are refused.
 TEST(ContactVelocities, ContactVelocitiesAreTheImpactLawOfWTransposeU) {
   Random rng(5903);
-  double worst = 0.0, worst_delassus = 0.0;
+  WorstCase worst, worst_delassus;
   for (int k = 0; k < 100; ++k) {
     const ContactProblem p = random_problem(rng, 3, {{2, 0}, {1, kStatic}, {kStatic, 2}, {0, 1}});
     const MatrixX W = dense_W(p);
     const VectorX expected = W.transpose() * stack(p.u_free) + restituted(p);
     const VectorX xi = stack(contact_velocities(p, p.u_free));
-    worst = std::max(worst, (xi - expected).norm() / expected.norm());
+    worst.update((xi - expected).norm() / expected.norm(), k,
+                 [&] { return describe("problem", p); });
     std::vector<Vector3> lambda;
     for (std::size_t i = 0; i < p.contacts.size(); ++i) lambda.push_back(rng.vector3(-1, 2));
     const VectorX xi_end = stack(contact_velocities(p, velocities_from_percussions(p, lambda)));
     const VectorX G_lambda = W.transpose() * dense_M_inv(p) * W * stack(lambda);
-    worst_delassus = std::max(worst_delassus, (xi_end - xi - G_lambda).norm() / G_lambda.norm());
+    worst_delassus.update((xi_end - xi - G_lambda).norm() / G_lambda.norm(), k,
+                          [&] { return describe("problem", p, "lambda", lambda); });
   }
-  EXPECT_LE(worst, kProductTol);
-  EXPECT_LE(worst_delassus, kProductTol);
+  EXPECT_LE(worst.value(), kProductTol) << worst;
+  EXPECT_LE(worst_delassus.value(), kProductTol) << worst_delassus;
   const ContactProblem p = random_problem(rng, 2, {{0, 1}});
   EXPECT_THROW(contact_velocities(p, std::vector<Vector6>(1, Vector6::Zero())),
                grbd::InvalidArgument);

@@ -25,6 +25,7 @@
 #include "grbd/core/checks.hpp"
 #include "grbd/core/error.hpp"
 #include "grbd_test/random.hpp"
+#include "grbd_test/worst_case.hpp"
 
 namespace {
 
@@ -37,7 +38,9 @@ using grbd::contact::natural_map_residual;
 using grbd::contact::prox_cone;
 using grbd::contact::prox_disk;
 using grbd::contact::prox_nonnegative;
+using grbd::test::describe;
 using grbd::test::Random;
+using grbd::test::WorstCase;
 
 constexpr double kEps = std::numeric_limits<double>::epsilon();
 constexpr double kInf = std::numeric_limits<double>::infinity();
@@ -150,6 +153,11 @@ std::vector<Solution> random_solutions(Random& rng, int count) {
   return solutions;
 }
 
+// describe() of a solution: its case, λ, ξ and μ.
+std::string describe_solution(const Solution& s) {
+  return describe("kind", s.kind, "lambda", s.lambda, "xi", s.xi, "mu", s.mu);
+}
+
 }  // namespace
 
 // ----------------------------------------------------------------------------------------------
@@ -174,18 +182,18 @@ TEST(Exercise5_1, IsMaxWithZero) {
 // and random z ≥ 0; idempotence.
 TEST(Exercise5_1, SatisfiesTheVariationalInequality) {
   Random rng(5102);
-  double worst = 0.0;
+  WorstCase worst;
   for (int k = 0; k < 10000; ++k) {
     const double x = rng.uniform(-5.0, 5.0);
     const double y = prox_nonnegative(x);
     ASSERT_GE(y, 0.0) << "x = " << x;
     for (const double z : {0.0, 2.0 * y, rng.uniform(0.0, 5.0), rng.uniform(0.0, 1e-3)}) {
-      worst = std::max(worst, (x - y) * (z - y));
+      worst.update((x - y) * (z - y), k, [&] { return describe("x", x, "y", y, "z", z); });
     }
     ASSERT_EQ(prox_nonnegative(y), y) << "x = " << x;
   }
-  RecordProperty("worst_variational_inequality", grbd::format_number(worst));
-  EXPECT_LE(worst, kVariationalTol);
+  RecordProperty("worst_variational_inequality", grbd::format_number(worst.value()));
+  EXPECT_LE(worst.value(), kVariationalTol) << worst;
 }
 
 // Reference: the unilateral contact law written as complementarity, 0 ≤ λ ⟂ ξ ≥ 0, holds exactly
@@ -218,7 +226,7 @@ TEST(Exercise5_1, FixedPointsAreTheComplementaryPairs) {
 TEST(Exercise5_2, MatchesTheClosedForm) {
   Random rng(5201);
   int inside = 0, outside = 0;
-  double worst = 0.0;
+  WorstCase worst;
   for (int k = 0; k < 10000; ++k) {
     const Vector2 x(rng.uniform(-3.0, 3.0), rng.uniform(-3.0, 3.0));
     const double rho = rng.uniform(0.0, 3.0);
@@ -229,13 +237,14 @@ TEST(Exercise5_2, MatchesTheClosedForm) {
     } else if (std::hypot(x(0), x(1)) > rho * (1.0 + 1e-12)) {
       ++outside;
       const Vector2 expected = rho * circle(std::atan2(x(1), x(0)));
-      worst = std::max(worst, (y - expected).cwiseAbs().maxCoeff() / std::max(rho, 1e-300));
+      worst.update((y - expected).cwiseAbs().maxCoeff() / std::max(rho, 1e-300), k,
+                   [&] { return describe("x", x, "rho", rho, "found", y); });
     }
   }
   EXPECT_GT(inside, 1000);
   EXPECT_GT(outside, 1000);
-  RecordProperty("worst_relative_error", grbd::format_number(worst));
-  EXPECT_LE(worst, 8 * kEps);
+  RecordProperty("worst_relative_error", grbd::format_number(worst.value()));
+  EXPECT_LE(worst.value(), 8 * kEps) << worst;
 }
 
 // Reference: points on the circle come back (to round-off), the centre stays, and the disk of
@@ -259,13 +268,13 @@ TEST(Exercise5_2, BoundaryCentreAndRadiusZero) {
 // the circle, two of the interior and the boundary points along ±x. Tolerance kVariationalTol.
 TEST(Exercise5_2, SatisfiesTheVariationalInequality) {
   Random rng(5203);
-  double worst = 0.0, worst_outside = 0.0;
+  WorstCase worst, worst_outside;
   for (int k = 0; k < 10000; ++k) {
     Vector2 x(rng.uniform(-3.0, 3.0), rng.uniform(-3.0, 3.0));
     if (k % 5 == 4) x *= (k % 10 == 4) ? 1e-3 : 1e3;
     const double rho = k % 13 == 0 ? 0.0 : rng.uniform(0.0, 3.0);
     const Vector2 y = prox_disk(x, rho);
-    worst_outside = std::max(worst_outside, y.norm() - rho);
+    worst_outside.update(y.norm() - rho, k, [&] { return describe("x", x, "rho", rho, "y", y); });
     std::vector<Vector2> z{Vector2::Zero(), 0.5 * y};
     for (int i = 0; i < 4; ++i) z.push_back(rho * circle(rng.uniform(0.0, 2 * kPi)));
     for (int i = 0; i < 2; ++i) {
@@ -276,33 +285,36 @@ TEST(Exercise5_2, SatisfiesTheVariationalInequality) {
       z.push_back(-rho * x.normalized());
     }
     for (const Vector2& zi : z) {
-      worst = std::max(worst, (x - y).dot(zi - y) / scale(x.norm(), zi.norm()));
+      worst.update((x - y).dot(zi - y) / scale(x.norm(), zi.norm()), k,
+                   [&] { return describe("x", x, "rho", rho, "y", y, "z", zi); });
     }
   }
-  RecordProperty("worst_variational_inequality", grbd::format_number(worst));
-  EXPECT_LE(worst, kVariationalTol);
-  EXPECT_LE(worst_outside, kRoundOff * 3e3);
+  RecordProperty("worst_variational_inequality", grbd::format_number(worst.value()));
+  EXPECT_LE(worst.value(), kVariationalTol) << worst;
+  EXPECT_LE(worst_outside.value(), kRoundOff * 3e3) << worst_outside;
 }
 
 // Reference: a projection is idempotent and non-expansive, ‖P(x) − P(x')‖ ≤ ‖x − x'‖, for random
 // pairs far apart and 1e-6 apart; tolerance a few ε (|x| + |x'|).
 TEST(Exercise5_2, IsIdempotentAndNonExpansive) {
   Random rng(5204);
-  double worst_idempotence = 0.0, worst_expansion = 0.0;
+  WorstCase worst_idempotence, worst_expansion;
   for (int k = 0; k < 10000; ++k) {
     const double rho = rng.uniform(0.0, 3.0);
     const Vector2 x(rng.uniform(-4.0, 4.0), rng.uniform(-4.0, 4.0));
     const Vector2 x2 = k % 2 == 0 ? Vector2(rng.uniform(-4.0, 4.0), rng.uniform(-4.0, 4.0))
                                   : Vector2(x + 1e-6 * Vector2(rng.uniform(), rng.uniform()));
     const Vector2 y = prox_disk(x, rho);
-    worst_idempotence = std::max(worst_idempotence, (prox_disk(y, rho) - y).norm() / x.norm());
+    worst_idempotence.update((prox_disk(y, rho) - y).norm() / x.norm(), k,
+                             [&] { return describe("x", x, "rho", rho); });
     const double expansion = (y - prox_disk(x2, rho)).norm() - (x - x2).norm();
-    worst_expansion = std::max(worst_expansion, expansion / (x.norm() + x2.norm()));
+    worst_expansion.update(expansion / (x.norm() + x2.norm()), k,
+                           [&] { return describe("x", x, "x'", x2, "rho", rho); });
   }
-  RecordProperty("worst_idempotence", grbd::format_number(worst_idempotence));
-  RecordProperty("worst_expansion", grbd::format_number(worst_expansion));
-  EXPECT_LE(worst_idempotence, kRoundOff);
-  EXPECT_LE(worst_expansion, kRoundOff);
+  RecordProperty("worst_idempotence", grbd::format_number(worst_idempotence.value()));
+  RecordProperty("worst_expansion", grbd::format_number(worst_expansion.value()));
+  EXPECT_LE(worst_idempotence.value(), kRoundOff) << worst_idempotence;
+  EXPECT_LE(worst_expansion.value(), kRoundOff) << worst_expansion;
 }
 
 // ----------------------------------------------------------------------------------------------
@@ -316,7 +328,7 @@ TEST(Exercise5_2, IsIdempotentAndNonExpansive) {
 TEST(Exercise5_3, MatchesTheClosedForm) {
   Random rng(5301);
   int inside = 0, polar = 0, surface = 0;
-  double worst = 0.0;
+  WorstCase worst;
   for (int k = 0; k < 10000; ++k) {
     const auto [x, mu] = random_cone_sample(rng, k);
     const Vector3 y = prox_cone(x, mu);
@@ -329,14 +341,15 @@ TEST(Exercise5_3, MatchesTheClosedForm) {
       ASSERT_EQ(y, Vector3::Zero()) << "x = " << x.transpose() << ", mu = " << mu;
     } else {
       ++surface;
-      worst = std::max(worst, (y - reference_prox_cone(x, mu)).norm() / x.norm());
+      worst.update((y - reference_prox_cone(x, mu)).norm() / x.norm(), k,
+                   [&] { return describe("x", x, "mu", mu, "found", y); });
     }
   }
   EXPECT_GT(inside, 1000);
   EXPECT_GT(polar, 1000);
   EXPECT_GT(surface, 1000);
-  RecordProperty("worst_relative_error", grbd::format_number(worst));
-  EXPECT_LE(worst, kRoundOff);
+  RecordProperty("worst_relative_error", grbd::format_number(worst.value()));
+  EXPECT_LE(worst.value(), kRoundOff) << worst;
 }
 
 // Reference: the variational inequality on K_μ for 10⁴ seeded x: y ∈ K_μ to round-off and
@@ -344,11 +357,12 @@ TEST(Exercise5_3, MatchesTheClosedForm) {
 // four random points of the surface, two of the interior, and the surface points along ±x_T.
 TEST(Exercise5_3, SatisfiesTheVariationalInequality) {
   Random rng(5302);
-  double worst = 0.0, worst_membership = 0.0;
+  WorstCase worst, worst_membership;
   for (int k = 0; k < 10000; ++k) {
     const auto [x, mu] = random_cone_sample(rng, k);
     const Vector3 y = prox_cone(x, mu);
-    worst_membership = std::max(worst_membership, cone_violation(y, mu) / x.norm());
+    worst_membership.update(cone_violation(y, mu) / x.norm(), k,
+                            [&] { return describe("x", x, "mu", mu, "y", y); });
     std::vector<Vector3> z{Vector3::Zero(), 2.0 * y, 0.5 * y};
     for (int i = 0; i < 4; ++i) {
       z.push_back(cone_point(rng.uniform(0.0, 3.0), 1.0, rng.uniform(0.0, 2 * kPi), mu));
@@ -361,32 +375,34 @@ TEST(Exercise5_3, SatisfiesTheVariationalInequality) {
     z.push_back(cone_point(rng.uniform(0.0, 3.0), 1.0, phi, mu));
     z.push_back(cone_point(rng.uniform(0.0, 3.0), 1.0, phi + kPi, mu));
     for (const Vector3& zi : z) {
-      worst = std::max(worst, (x - y).dot(zi - y) / scale(x.norm(), zi.norm()));
+      worst.update((x - y).dot(zi - y) / scale(x.norm(), zi.norm()), k,
+                   [&] { return describe("x", x, "mu", mu, "y", y, "z", zi); });
     }
   }
-  RecordProperty("worst_variational_inequality", grbd::format_number(worst));
-  RecordProperty("worst_membership", grbd::format_number(worst_membership));
-  EXPECT_LE(worst, kVariationalTol);
-  EXPECT_LE(worst_membership, kRoundOff);
+  RecordProperty("worst_variational_inequality", grbd::format_number(worst.value()));
+  RecordProperty("worst_membership", grbd::format_number(worst_membership.value()));
+  EXPECT_LE(worst.value(), kVariationalTol) << worst;
+  EXPECT_LE(worst_membership.value(), kRoundOff) << worst_membership;
 }
 
 // Reference: Moreau's decomposition. The polar cone of K_μ is K_μ° = −K_{1/μ}, so
 // P_K°(x) = −P_{K_{1/μ}}(−x), and x = P_K(x) + P_K°(x) with P_K(x) ⟂ P_K°(x), for μ ∈ [0.05, 20).
 TEST(Exercise5_3, MoreauDecompositionWithThePolarCone) {
   Random rng(5303);
-  double worst_sum = 0.0, worst_orthogonality = 0.0;
+  WorstCase worst_sum, worst_orthogonality;
   for (int k = 0; k < 10000; ++k) {
     const Vector3 x = rng.vector3(-3.0, 3.0);
     const double mu = std::exp(rng.uniform(std::log(0.05), std::log(20.0)));
     const Vector3 p = prox_cone(x, mu);
     const Vector3 q = -prox_cone(-x, 1.0 / mu);
-    worst_sum = std::max(worst_sum, (p + q - x).norm() / x.norm());
-    worst_orthogonality = std::max(worst_orthogonality, std::abs(p.dot(q)) / x.squaredNorm());
+    const auto inputs = [&] { return describe("x", x, "mu", mu, "P_K(x)", p, "P_K°(x)", q); };
+    worst_sum.update((p + q - x).norm() / x.norm(), k, inputs);
+    worst_orthogonality.update(std::abs(p.dot(q)) / x.squaredNorm(), k, inputs);
   }
-  RecordProperty("worst_sum", grbd::format_number(worst_sum));
-  RecordProperty("worst_orthogonality", grbd::format_number(worst_orthogonality));
-  EXPECT_LE(worst_sum, kRoundOff);
-  EXPECT_LE(worst_orthogonality, kRoundOff);
+  RecordProperty("worst_sum", grbd::format_number(worst_sum.value()));
+  RecordProperty("worst_orthogonality", grbd::format_number(worst_orthogonality.value()));
+  EXPECT_LE(worst_sum.value(), kRoundOff) << worst_sum;
+  EXPECT_LE(worst_orthogonality.value(), kRoundOff) << worst_orthogonality;
 }
 
 // Reference: for μ = 0 the cone is the half-line {y_N ≥ 0, y_T = 0} (frictionless contact):
@@ -454,42 +470,45 @@ TEST(Exercise5_3, LargeMuApproachesTheHalfSpace) {
 // pairs far apart and 1e-6 apart; tolerance a few ε (|x| + |x'|).
 TEST(Exercise5_3, IsIdempotentAndNonExpansive) {
   Random rng(5307);
-  double worst_idempotence = 0.0, worst_expansion = 0.0;
+  WorstCase worst_idempotence, worst_expansion;
   for (int k = 0; k < 10000; ++k) {
     const auto [x, mu] = random_cone_sample(rng, k);
     const Vector3 x2 = k % 2 == 0 ? Vector3(x.norm() * rng.vector3())
                                   : Vector3(x + 1e-6 * x.norm() * rng.vector3());
     const Vector3 y = prox_cone(x, mu);
-    worst_idempotence = std::max(worst_idempotence, (prox_cone(y, mu) - y).norm() / x.norm());
+    worst_idempotence.update((prox_cone(y, mu) - y).norm() / x.norm(), k,
+                             [&] { return describe("x", x, "mu", mu); });
     const double expansion = (y - prox_cone(x2, mu)).norm() - (x - x2).norm();
-    worst_expansion = std::max(worst_expansion, expansion / (x.norm() + x2.norm()));
+    worst_expansion.update(expansion / (x.norm() + x2.norm()), k,
+                           [&] { return describe("x", x, "x'", x2, "mu", mu); });
   }
-  RecordProperty("worst_idempotence", grbd::format_number(worst_idempotence));
-  RecordProperty("worst_expansion", grbd::format_number(worst_expansion));
-  EXPECT_LE(worst_idempotence, kRoundOff);
-  EXPECT_LE(worst_expansion, kRoundOff);
+  RecordProperty("worst_idempotence", grbd::format_number(worst_idempotence.value()));
+  RecordProperty("worst_expansion", grbd::format_number(worst_expansion.value()));
+  EXPECT_LE(worst_idempotence.value(), kRoundOff) << worst_idempotence;
+  EXPECT_LE(worst_expansion.value(), kRoundOff) << worst_expansion;
 }
 
 // Reference: the cone is invariant under positive scaling and under rotations about the normal
 // axis, so P(t x) = t P(x) for t ∈ (0, 100) and P(R x) = R P(x). Tolerance 16 ε |x|.
 TEST(Exercise5_3, IsPositivelyHomogeneousAndSymmetricAboutTheNormal) {
   Random rng(5308);
-  double worst_scaling = 0.0, worst_rotation = 0.0;
+  WorstCase worst_scaling, worst_rotation;
   for (int k = 0; k < 10000; ++k) {
     const auto [x, mu] = random_cone_sample(rng, k);
     const double t = rng.uniform(1e-3, 100.0);
     const double phi = rng.uniform(0.0, 2 * kPi);
     const Vector3 y = prox_cone(x, mu);
-    worst_scaling = std::max(worst_scaling, (prox_cone(t * x, mu) - t * y).norm() / (t * x.norm()));
-    worst_rotation =
-        std::max(worst_rotation,
-                 (prox_cone(rotate_about_normal(x, phi), mu) - rotate_about_normal(y, phi)).norm() /
-                     x.norm());
+    worst_scaling.update((prox_cone(t * x, mu) - t * y).norm() / (t * x.norm()), k,
+                         [&] { return describe("x", x, "mu", mu, "t", t); });
+    worst_rotation.update(
+        (prox_cone(rotate_about_normal(x, phi), mu) - rotate_about_normal(y, phi)).norm() /
+            x.norm(),
+        k, [&] { return describe("x", x, "mu", mu, "phi", phi); });
   }
-  RecordProperty("worst_scaling", grbd::format_number(worst_scaling));
-  RecordProperty("worst_rotation", grbd::format_number(worst_rotation));
-  EXPECT_LE(worst_scaling, kRoundOff);
-  EXPECT_LE(worst_rotation, kRoundOff);
+  RecordProperty("worst_scaling", grbd::format_number(worst_scaling.value()));
+  RecordProperty("worst_rotation", grbd::format_number(worst_rotation.value()));
+  EXPECT_LE(worst_scaling.value(), kRoundOff) << worst_scaling;
+  EXPECT_LE(worst_rotation.value(), kRoundOff) << worst_rotation;
 }
 
 // ----------------------------------------------------------------------------------------------
@@ -501,24 +520,24 @@ TEST(Exercise5_3, IsPositivelyHomogeneousAndSymmetricAboutTheNormal) {
 // times the size of the numbers (r |ξ| + |λ|).
 TEST(ProxUpdates, SolutionsAreFixedPointsForEveryR) {
   Random rng(5401);
-  double worst_ac = 0.0, worst_ds = 0.0;
+  WorstCase worst_ac, worst_ds;
   for (const Solution& s : random_solutions(rng, 4000)) {
     for (const double r_N : {1e-3, 0.7, 1.0, 50.0}) {
       for (const double r_T : {1e-3, 1.0, 50.0}) {
         const double size = 1.0 + s.lambda.norm() + std::max(r_N, r_T) * s.xi.norm();
-        worst_ac = std::max(
-            worst_ac,
-            (alart_curnier_update(s.lambda, s.xi, r_N, r_T, s.mu) - s.lambda).norm() / size);
+        worst_ac.update(
+            (alart_curnier_update(s.lambda, s.xi, r_N, r_T, s.mu) - s.lambda).norm() / size,
+            [&] { return describe_solution(s) + ", " + describe("r_N", r_N, "r_T", r_T); });
       }
       const double size = 1.0 + s.lambda.norm() + r_N * (1.0 + s.mu) * s.xi.norm();
-      worst_ds =
-          std::max(worst_ds, (de_saxce_update(s.lambda, s.xi, r_N, s.mu) - s.lambda).norm() / size);
+      worst_ds.update((de_saxce_update(s.lambda, s.xi, r_N, s.mu) - s.lambda).norm() / size,
+                      [&] { return describe_solution(s) + ", " + describe("r", r_N); });
     }
   }
-  RecordProperty("worst_alart_curnier", grbd::format_number(worst_ac));
-  RecordProperty("worst_de_saxce", grbd::format_number(worst_ds));
-  EXPECT_LE(worst_ac, kRoundOff);
-  EXPECT_LE(worst_ds, kRoundOff);
+  RecordProperty("worst_alart_curnier", grbd::format_number(worst_ac.value()));
+  RecordProperty("worst_de_saxce", grbd::format_number(worst_ds.value()));
+  EXPECT_LE(worst_ac.value(), kRoundOff) << worst_ac;
+  EXPECT_LE(worst_ds.value(), kRoundOff) << worst_ds;
 }
 
 // Reference: pairs that violate the law move under both updates: force with a separating
@@ -553,7 +572,7 @@ TEST(ProxUpdates, NonSolutionsAreNotFixedPoints) {
 // of radius μ λ_N⁺ for λ_T − r_T ξ_T (radius 0: λ_T⁺ = 0); tolerance 16 ε (|λ| + r|ξ|).
 TEST(ProxUpdates, AlartCurnierIsNormalThenTangential) {
   Random rng(5403);
-  double worst = 0.0;
+  WorstCase worst;
   for (int k = 0; k < 10000; ++k) {
     const Vector3 lambda = rng.vector3(-1.0, 3.0);
     const Vector3 xi = rng.vector3(-2.0, 2.0);
@@ -565,10 +584,11 @@ TEST(ProxUpdates, AlartCurnierIsNormalThenTangential) {
     const Vector2 lambda_T = x_T.norm() <= radius ? x_T : Vector2(radius * x_T.normalized());
     const Vector3 expected(lambda_N, lambda_T(0), lambda_T(1));
     const double size = lambda.norm() + 3.0 * xi.norm();
-    worst =
-        std::max(worst, (alart_curnier_update(lambda, xi, r_N, r_T, mu) - expected).norm() / size);
+    worst.update((alart_curnier_update(lambda, xi, r_N, r_T, mu) - expected).norm() / size, k, [&] {
+      return describe("lambda", lambda, "xi", xi, "r_N", r_N, "r_T", r_T, "mu", mu);
+    });
   }
-  EXPECT_LE(worst, kRoundOff);
+  EXPECT_LE(worst.value(), kRoundOff) << worst;
 }
 
 // Reference: the De Saxcé update lands in the cone, and the result does not depend on ξ_N and
@@ -577,20 +597,23 @@ TEST(ProxUpdates, AlartCurnierIsNormalThenTangential) {
 // agree up to that rotation (symmetry of the cone).
 TEST(ProxUpdates, DeSaxceStaysInTheConeAndIsSymmetric) {
   Random rng(5404);
-  double worst_membership = 0.0, worst_rotation = 0.0;
+  WorstCase worst_membership, worst_rotation;
   for (int k = 0; k < 10000; ++k) {
     const Vector3 lambda = rng.vector3(-1.0, 3.0);
     const Vector3 xi = rng.vector3(-2.0, 2.0);
     const double r = rng.uniform(0.01, 3.0), mu = rng.uniform(0.0, 2.0);
     const double phi = rng.uniform(0.0, 2 * kPi);
     const Vector3 y = de_saxce_update(lambda, xi, r, mu);
-    worst_membership = std::max(worst_membership, cone_violation(y, mu));
+    const auto inputs = [&] {
+      return describe("lambda", lambda, "xi", xi, "r", r, "mu", mu, "phi", phi);
+    };
+    worst_membership.update(cone_violation(y, mu), k, inputs);
     const Vector3 y_rotated =
         de_saxce_update(rotate_about_normal(lambda, phi), rotate_about_normal(xi, phi), r, mu);
-    worst_rotation = std::max(worst_rotation, (y_rotated - rotate_about_normal(y, phi)).norm());
+    worst_rotation.update((y_rotated - rotate_about_normal(y, phi)).norm(), k, inputs);
   }
-  EXPECT_LE(worst_membership, 10 * kRoundOff);
-  EXPECT_LE(worst_rotation, 10 * kRoundOff);
+  EXPECT_LE(worst_membership.value(), 10 * kRoundOff) << worst_membership;
+  EXPECT_LE(worst_rotation.value(), 10 * kRoundOff) << worst_rotation;
 }
 
 // ----------------------------------------------------------------------------------------------
@@ -603,13 +626,14 @@ TEST(ProxUpdates, DeSaxceStaysInTheConeAndIsSymmetric) {
 // F = λ − P_K(0) = (1, 0, 0).
 TEST(NaturalMap, VanishesExactlyOnSolutions) {
   Random rng(5501);
-  double worst = 0.0;
+  WorstCase worst;
   for (const Solution& s : random_solutions(rng, 4000)) {
     const double size = 1.0 + s.lambda.norm() + (1.0 + s.mu) * s.xi.norm();
-    worst = std::max(worst, natural_map(s.lambda, s.xi, s.mu).norm() / size);
+    worst.update(natural_map(s.lambda, s.xi, s.mu).norm() / size,
+                 [&] { return describe_solution(s); });
   }
-  RecordProperty("worst_natural_map", grbd::format_number(worst));
-  EXPECT_LE(worst, kRoundOff);
+  RecordProperty("worst_natural_map", grbd::format_number(worst.value()));
+  EXPECT_LE(worst.value(), kRoundOff) << worst;
   for (const double mu : {0.0, 0.5, 2.0}) {
     EXPECT_EQ(natural_map(Vector3::Zero(), Vector3(-1.0, 0.0, 0.0), mu), Vector3(-1.0, 0.0, 0.0));
     EXPECT_EQ(natural_map(Vector3(1.0, 0.0, 0.0), Vector3(1.0, 0.0, 0.0), mu),

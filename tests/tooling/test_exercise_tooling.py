@@ -20,6 +20,7 @@ def load_script(name):
     loader = importlib.machinery.SourceFileLoader(name.replace("-", "_"), str(ROOT / "scripts" / name))
     spec = importlib.util.spec_from_loader(loader.name, loader)
     module = importlib.util.module_from_spec(spec)
+    sys.modules[loader.name] = module  # dataclasses look their module up there
     loader.exec_module(module)
     return module
 
@@ -85,28 +86,46 @@ class GeneratorTest(unittest.TestCase):
             self.assertIn("grbd::NotImplemented", text, path)
 
 
+# A stand-in for a GoogleTest program: it lists its tests and runs those its --gtest_filter names
+# (a ':'-separated list of 'Suite.Test' or 'Suite.*'), printing what GoogleTest prints.
 FAKE_GTEST = """#!/usr/bin/env python3
-import json, os, signal, sys
+import os, signal, sys, time
 args = dict(a.split("=", 1) for a in sys.argv[1:] if "=" in a)
-flt = args.get("--gtest_filter", "*")
+patterns = args.get("--gtest_filter", "*").split(":")
 behaviour = {behaviour!r}
 if "--gtest_list_tests" in sys.argv:
     print("Suite.")
     for name in behaviour:
         print("  " + name)
     sys.exit(0)
-tests = []
+failed = False
 for name, outcome in behaviour.items():
-    if flt not in ("Suite.*", "Suite." + name):
+    if not any(p in ("*", "Suite.*", "Suite." + name) for p in patterns):
         continue
+    print("[ RUN      ] Suite." + name, flush=True)
     if outcome == "crash":
         os.kill(os.getpid(), signal.SIGSEGV)
-    failures = {{"pass": [], "notimpl": [{{"failure": "C++ exception with description \\"[NotImplemented] Exercise 1.1\\" thrown in the test body."}}],
-                "fail": [{{"failure": "Expected equality"}}]}}[outcome]
-    tests.append({{"name": name, "result": "COMPLETED", "failures": failures}})
-out = args["--gtest_output"][len("json:"):]
-json.dump({{"testsuites": [{{"name": "Suite", "testsuite": tests}}]}}, open(out, "w"))
-sys.exit(1 if any(t["failures"] for t in tests) else 0)
+    if outcome == "hang":
+        time.sleep(3600)
+    if outcome == "pass":
+        print("[       OK ] Suite." + name + " (0 ms)", flush=True)
+        continue
+    failed = True
+    if outcome == "notimpl":
+        print("unknown file: Failure")
+        print('C++ exception with description "[NotImplemented] Exercise 1.1 (x) is not '
+              'implemented yet" thrown in the test body.')
+    elif outcome == "foreign":
+        print("unknown file: Failure")
+        print('C++ exception with description "[NotImplemented] Exercise 2.3 (y)" thrown.')
+    else:
+        print("test.cpp:12: Failure")
+        print("Expected: (worst.value()) <= (kRel), actual: 0.5 vs 1e-14")
+        print("worst error 0.5 at sample 3: P = (1, 2, 3, 4)")
+    print("[  FAILED  ] Suite." + name + " (0 ms)", flush=True)
+if failed:
+    print("[  FAILED  ] 1 test, listed below:")
+sys.exit(1 if failed else 0)
 """
 
 
@@ -118,16 +137,64 @@ class GraderTest(unittest.TestCase):
         path.chmod(path.stat().st_mode | stat.S_IEXEC)
         return path
 
+    def run_fake(self, behaviour, timeout=5.0):
+        binary = self.fake_binary(behaviour)
+        results = grade.run_tests(binary, [f"Suite.{n}" for n in behaviour], timeout)
+        return {name: r.outcome for name, r in results.items()}, results
+
     def test_outcomes_are_classified(self):
-        binary = self.fake_binary({"A": "pass", "B": "notimpl", "C": "fail"})
-        outcomes = grade.run_suite(binary, "Suite", ["A", "B", "C"])
+        outcomes, results = self.run_fake({"A": "pass", "B": "notimpl", "C": "fail"})
         self.assertEqual(outcomes, {"Suite.A": "passed", "Suite.B": "not implemented",
                                     "Suite.C": "failed"})
+        self.assertEqual(results["Suite.B"].needs, ("1.1",))
 
-    def test_a_crash_is_pinned_on_the_test_that_crashed(self):
-        binary = self.fake_binary({"A": "pass", "B": "crash"})
-        outcomes = grade.run_suite(binary, "Suite", ["A", "B"])
-        self.assertEqual(outcomes, {"Suite.A": "passed", "Suite.B": "crashed"})
+    def test_a_failure_keeps_its_message_with_the_worst_input(self):
+        _, results = self.run_fake({"A": "fail"})
+        self.assertIn("actual: 0.5 vs 1e-14", results["Suite.A"].message)
+        self.assertIn("P = (1, 2, 3, 4)", results["Suite.A"].message)
+
+    def test_a_crash_is_pinned_on_the_test_that_crashed_and_the_rest_still_run(self):
+        outcomes, _ = self.run_fake({"A": "pass", "B": "crash", "C": "pass"})
+        self.assertEqual(outcomes, {"Suite.A": "passed", "Suite.B": "crashed",
+                                    "Suite.C": "passed"})
+
+    def test_a_hanging_test_times_out_and_the_rest_still_run(self):
+        start = __import__("time").monotonic()
+        outcomes, results = self.run_fake({"A": "hang", "B": "pass", "C": "notimpl"},
+                                          timeout=1.0)
+        self.assertEqual(outcomes, {"Suite.A": "timed out", "Suite.B": "passed",
+                                    "Suite.C": "not implemented"})
+        self.assertIn("did not finish within 1 s", results["Suite.A"].message)
+        self.assertLess(__import__("time").monotonic() - start, 30.0)
+
+    def test_after_three_timeouts_the_rest_is_not_run(self):
+        outcomes, _ = self.run_fake({"A": "hang", "B": "hang", "C": "hang", "D": "pass"},
+                                    timeout=0.5)
+        self.assertEqual(list(outcomes.values()), ["timed out"] * 3 + ["not run"])
+
+    def test_the_table_names_stubs_of_other_chapters(self):
+        binary = self.fake_binary({"A": "foreign"})
+        results = {"Exercise1_1": {"Exercise1_1.A": grade.Result("not implemented", "",
+                                                                 ("2.3",))}}
+        exercises = [gx.Exercise("1.1", "the quaternion product", "01-kinematics", "f", 1)]
+        import contextlib
+        import io
+        out = io.StringIO()
+        with contextlib.redirect_stdout(out):
+            grade.print_table("01-kinematics", exercises, {"Exercise1_1": ["A"]}, results)
+        self.assertIn("stops at the stub of Exercise 2.3 (chapter 2)", out.getvalue())
+        self.assertIn("--solved 2", out.getvalue())
+        del binary
+
+    def test_specs_and_solved_chapters_are_parsed(self):
+        self.assertEqual(grade.parse_spec("1.3"), ("01-kinematics", "1.3"))
+        self.assertEqual(grade.parse_spec("1"), ("01-kinematics", None))
+        self.assertEqual(grade.parse_chapters("1-3,5", [1, 2, 3, 4, 5]), [1, 2, 3, 5])
+        for bad in ("x", "4-2", "9"):
+            with self.assertRaises(gx.ExerciseError):
+                grade.parse_chapters(bad, [1, 2, 3, 4, 5])
+        with self.assertRaises(gx.ExerciseError):
+            grade.parse_spec("1.99")
 
 
 if __name__ == "__main__":

@@ -9,8 +9,33 @@
 #include "grbd/kinematics/rigid_motion.hpp"
 #include "grbd_test/random.hpp"
 #include "grbd_test/references.hpp"
+#include "grbd_test/worst_case.hpp"
 
 namespace grbd::test {
+
+/// describe() of a body: (m = …, K_Theta = [Θ₁, Θ₂, Θ₃]).
+template <>
+struct Describer<body::RigidBody> {
+  static void put(std::ostream& os, const body::RigidBody& b) {
+    os << "(" << describe("m", b.m, "K_Theta", b.K_Theta) << ")";
+  }
+};
+
+/// describe() of a state: (q = [r, p], u = [v, ω]).
+template <>
+struct Describer<body::State> {
+  static void put(std::ostream& os, const body::State& x) {
+    os << "(" << describe("q", x.q, "u", x.u) << ")";
+  }
+};
+
+/// describe() of loads: (I_F = […], K_M = […]).
+template <>
+struct Describer<body::Loads> {
+  static void put(std::ostream& os, const body::Loads& l) {
+    os << "(" << describe("I_F", l.I_F, "K_M", l.K_M) << ")";
+  }
+};
 
 /// A random body: mass in [0.5, 3), principal moments in [0.1, 3).
 inline body::RigidBody random_body(Random& rng) {
