@@ -1,10 +1,13 @@
-# cmake -DDOXYGEN=... -DDOXYFILE=... -DBOOK_DIR=... -DMATHJAX_DIR=... -P run_doxygen.cmake
+# cmake -DDOXYGEN=... -DDOXYFILE=... -DBOOK_DIR=... -DMATHJAX_DIR=... -DPYTHON=... -P run_doxygen.cmake
 #
-# Runs Doxygen on the book and fails, listing every warning, unless there are none. The local
-# MathJax is linked into the HTML tree so that the book typesets its mathematics offline.
+# Runs Doxygen on the book and fails, listing every warning, unless there are none. The parts of
+# the local MathJax that the book uses are copied (not linked) into the HTML tree, so that the book
+# typesets its mathematics offline, also after its folder has been copied elsewhere.
 file(MAKE_DIRECTORY ${BOOK_DIR}/html)
-if(NOT EXISTS ${BOOK_DIR}/html/mathjax)
-  file(CREATE_LINK ${MATHJAX_DIR} ${BOOK_DIR}/html/mathjax SYMBOLIC)
+execute_process(COMMAND ${PYTHON} ${CMAKE_CURRENT_LIST_DIR}/copy_mathjax.py ${MATHJAX_DIR} ${BOOK_DIR}/html
+                RESULT_VARIABLE copied)
+if(NOT copied EQUAL 0)
+  message(FATAL_ERROR "Could not copy MathJax into the book (exit code ${copied})")
 endif()
 file(REMOVE ${BOOK_DIR}/doxygen-warnings.log)
 execute_process(COMMAND ${DOXYGEN} ${DOXYFILE} RESULT_VARIABLE result)

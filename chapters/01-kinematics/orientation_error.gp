@@ -32,7 +32,7 @@ set format y "10^{%L}"
 set ytics 1e-16, 1e4
 set mytics 4
 set grid xtics ytics
-set key center right Left reverse opaque box spacing 1.1 font 'sans,10' maxrows 4
+set key center right Left reverse opaque box spacing 1.1 font 'sans,12' maxrows 4
 
 plot for [i=1:3] file(i) using 1:(after_start($6)) with lines lw 2 lc rgb word(colours, i) \
        title sprintf("explicit Euler (p/|p|), h = %s s", word(steps, i)), \

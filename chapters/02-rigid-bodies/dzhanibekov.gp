@@ -25,7 +25,7 @@ set xrange [0:20]
 set yrange [-8:8]
 set ytics 2
 set grid xtics ytics
-set key outside top center horizontal Left reverse font 'sans,10' spacing 1.1
+set key outside top center horizontal Left reverse font 'sans,12' spacing 1.1
 
 plot omega using 1:2 with lines lw 2 lc rgb "#0072b2" title "ω_1 (least moment Θ_1)", \
      omega using 1:3 with lines lw 2 lc rgb "#d55e00" title "ω_2 (intermediate Θ_2)", \

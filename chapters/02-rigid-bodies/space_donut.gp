@@ -36,7 +36,7 @@ set rmargin 3
 
 set multiplot layout 3,1 title "Torque-free space donut, h = 2 ms, all integrators" font 'sans,13'
 
-set key bottom right Left reverse opaque box font 'sans,10' maxrows 3 width -2
+set key bottom right Left reverse opaque box font 'sans,12' maxrows 3 width -2
 set format x ""
 set ylabel "kinetic energy:  |T(t) − T(0)| / T(0)"
 set yrange [1e-10:1e3]

@@ -34,7 +34,7 @@ set ylabel "u = cos ϑ of the symmetry axis"
 set xrange [0:1.5]
 set yrange [u_min - 0.2*(u_max - u_min) : u_max + 0.35*(u_max - u_min)]
 set grid xtics ytics
-set key top right horizontal font 'sans,10'
+set key top right horizontal font 'sans,12'
 plot motion using 1:2 with lines lw 1.5 lc rgb "#0072b2" title "CVODE", \
      u_min with lines dt 2 lw 1.5 lc rgb "#d55e00" title "u_{min}, u_{max}", \
      u_max with lines dt 2 lw 1.5 lc rgb "#d55e00" notitle

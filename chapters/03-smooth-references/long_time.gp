@@ -43,7 +43,7 @@ set format x ""
 set ylabel "energy:  max |E − E(0)| / E(0)"
 set yrange [1e-10:1e4]
 set ytics 1e-10, 100
-set key bottom right Left reverse opaque box font 'sans,9' spacing 1.0 samplen 2.5
+set key bottom right Left reverse opaque box font 'sans,12' spacing 1.0 samplen 2.5
 plot for [i=1:5] file(i) using 2:(positive($3)) with lines lw word(widths, i) \
        dt int(word(dashes, i)) lc rgb word(colours, i) title labels[i]
 

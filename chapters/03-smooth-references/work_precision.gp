@@ -63,7 +63,7 @@ unset grid
 unset logscale
 set xrange [0:1]
 set yrange [0:1]
-set key center center horizontal maxrows 3 Left reverse font 'sans,10' samplen 2.5 \
+set key center center horizontal maxrows 3 Left reverse font 'sans,12' samplen 2.5 \
     spacing 1.1 width 1
 plot for [i=1:n] NaN with linespoints lw 1.5 dt int(word(dashes, i)) \
        pt int(word(points, i)) ps 0.55 lc rgb word(colours, i) title labels[i]

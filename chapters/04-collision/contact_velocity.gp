@@ -27,14 +27,14 @@ set multiplot layout 3,1 title "Sphere past a tumbling box: γ_N = W^T u is the 
 
 set format x ""
 set ylabel "gap g_N [m]"
-set key top center horizontal Left reverse opaque box font 'sans,10'
+set key top center horizontal Left reverse opaque box font 'sans,12'
 plot data using 1:(only($5, 1, $2)) with lines lw 3 lc rgb "#0072b2" title "face region", \
      data using 1:(only($5, 2, $2)) with lines lw 3 lc rgb "#e69f00" title "edge region", \
      data using 1:(only($5, 3, $2)) with lines lw 3 lc rgb "#d55e00" title "vertex region", \
      0 with lines lw 1 lc rgb "#808080" notitle
 
 set ylabel "normal velocity [m/s]"
-set key top center horizontal Left reverse opaque box font 'sans,10'
+set key top center horizontal Left reverse opaque box font 'sans,12'
 plot data using 1:3 with lines lw 2.5 lc rgb "#0072b2" title "γ_N = W_a^T u_a − W_b^T u_b", \
      data using 1:4 every 40 with points pt 6 ps 1.0 lc rgb "#d55e00" title "(g_N(t+δ) − g_N(t−δ)) / 2δ"
 

@@ -21,6 +21,6 @@ set yrange [1e-7:2]
 set grid xtics ytics
 set xlabel "iteration k"
 set ylabel "‖F‖ / ‖c‖"
-set key top right opaque box font 'sans,10'
+set key top right opaque box font 'sans,12'
 set title "SOR with r = α / G_{ii}: the effect of the relaxation α"
 plot for [col=2:7] data using 1:col with lines lw 2 title columnheader(col)

@@ -24,7 +24,7 @@ set yrange [1e-7:2]
 set grid xtics ytics
 set xlabel "iteration k"
 set ylabel "‖F‖ / ‖c‖"
-set key top right opaque box font 'sans,10'
+set key top right opaque box font 'sans,12'
 
 set multiplot layout 1,2
 set title "frictional pile, μ = 0.5 (256 spheres, 1058 contacts)"

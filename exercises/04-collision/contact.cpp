@@ -12,7 +12,7 @@
 
 namespace grbd::collision {
 
-//! [tangent basis]
+// [tangent basis]
 Eigen::Matrix<double, 3, 2> tangent_basis(const Vector3& n) {
   // EXERCISE 4.4: a tangent basis of the contact plane
   // Hint: start from Frisvad's basis (2012), continuous everywhere but at n = −e_z; t2 = n × t1.
@@ -21,9 +21,9 @@ Eigen::Matrix<double, 3, 2> tangent_basis(const Vector3& n) {
                              "Chapter 4: Contact geometry and collision detection",
                              "exercises/04-collision/contact.cpp");
 }
-//! [tangent basis]
+// [tangent basis]
 
-//! [contact jacobian]
+// [contact jacobian]
 ContactJacobian contact_jacobian(const kinematics::Quaternion& p, const Vector3& K_rho,
                                  const Vector3& I_n, const Vector3& I_t1, const Vector3& I_t2) {
   // EXERCISE 4.5: the contact Jacobian of one body
@@ -33,6 +33,6 @@ ContactJacobian contact_jacobian(const kinematics::Quaternion& p, const Vector3&
                              "Chapter 4: Contact geometry and collision detection",
                              "exercises/04-collision/contact.cpp");
 }
-//! [contact jacobian]
+// [contact jacobian]
 
 }  // namespace grbd::collision

@@ -11,7 +11,7 @@
 
 namespace grbd::collision {
 
-//! [sphere sphere]
+// [sphere sphere]
 ContactGeometry sphere_sphere(const Vector3& c_a, double r_a, const Vector3& c_b, double r_b) {
   // EXERCISE 4.1: the contact of two spheres
   // Hint: the normal is the unit vector along the line of centres, from b towards a.
@@ -20,9 +20,9 @@ ContactGeometry sphere_sphere(const Vector3& c_a, double r_a, const Vector3& c_b
                              "Chapter 4: Contact geometry and collision detection",
                              "exercises/04-collision/narrow_phase.cpp");
 }
-//! [sphere sphere]
+// [sphere sphere]
 
-//! [sphere half space]
+// [sphere half space]
 ContactGeometry sphere_half_space(const Vector3& c, double r, const HalfSpace& half_space) {
   // EXERCISE 4.2: the contact of a sphere and a half-space
   // Hint: the signed distance of the centre to the boundary plane is nᵀc − offset.
@@ -30,9 +30,9 @@ ContactGeometry sphere_half_space(const Vector3& c, double r, const HalfSpace& h
                              "Chapter 4: Contact geometry and collision detection",
                              "exercises/04-collision/narrow_phase.cpp");
 }
-//! [sphere half space]
+// [sphere half space]
 
-//! [closest point]
+// [closest point]
 TrianglePoint closest_point_on_triangle(const Vector3& x, const Vector3& a, const Vector3& b,
                                         const Vector3& c) {
   // EXERCISE 4.3: the closest point on a triangle
@@ -42,6 +42,6 @@ TrianglePoint closest_point_on_triangle(const Vector3& x, const Vector3& a, cons
                              "Chapter 4: Contact geometry and collision detection",
                              "exercises/04-collision/narrow_phase.cpp");
 }
-//! [closest point]
+// [closest point]
 
 }  // namespace grbd::collision

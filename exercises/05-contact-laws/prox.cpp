@@ -16,38 +16,40 @@
 
 namespace grbd::contact {
 
-//! [prox nonnegative]
+// [prox nonnegative]
 double prox_nonnegative(double x) {
   // EXERCISE 5.1: the prox onto ℝ₊
-  // Hint: the closest point of [0, ∞) to x.
+  // Hint: the closest point of [0, ∞) to x: x itself when x ≥ 0, otherwise the boundary point.
+  // Hint: avoid tricks like (x + |x|)/2: the tests pass x = −∞, and −∞ + ∞ is NaN.
   throw grbd::NotImplemented("Exercise 5.1", "the prox onto ℝ₊",
                              "Chapter 5: Prox contact laws and solvers",
                              "exercises/05-contact-laws/prox.cpp");
 }
-//! [prox nonnegative]
+// [prox nonnegative]
 
-//! [prox disk]
+// [prox disk]
 Vector2 prox_disk(const Vector2& x, double radius) {
   // EXERCISE 5.2: the prox onto the disk of radius ρ
   // Hint: compare ‖x‖² with ρ² first: no square root (and no division) when x is inside.
+  // Hint: count ‖x‖ = ρ as inside, or x = 0 in the disk of radius 0 becomes 0/0.
   throw grbd::NotImplemented("Exercise 5.2", "the prox onto the disk of radius ρ",
                              "Chapter 5: Prox contact laws and solvers",
                              "exercises/05-contact-laws/prox.cpp");
 }
-//! [prox disk]
+// [prox disk]
 
-//! [prox cone]
+// [prox cone]
 Vector3 prox_cone(const Vector3& x, double mu) {
   // EXERCISE 5.3: the prox onto the Coulomb cone
   // Hint: three cases: x in K_μ; x in the polar cone {μ‖x_T‖ ≤ −x_N}; otherwise the surface.
-  // Hint: on the surface, y_N = (x_N + μ‖x_T‖)/(1 + μ²) and y_T points along x_T.
+  // Hint: for μ = 0, ‖x_T‖ ≤ μx_N alone accepts (−1, 0, 0); only the surface divides by ‖x_T‖.
   throw grbd::NotImplemented("Exercise 5.3", "the prox onto the Coulomb cone",
                              "Chapter 5: Prox contact laws and solvers",
                              "exercises/05-contact-laws/prox.cpp");
 }
-//! [prox cone]
+// [prox cone]
 
-//! [alart curnier]
+// [alart curnier]
 Vector3 alart_curnier_update(const Vector3& lambda, const Vector3& xi, double r_N, double r_T,
                              double mu) {
   const double lambda_N = prox_nonnegative(lambda(0) - r_N * xi(0));
@@ -55,15 +57,15 @@ Vector3 alart_curnier_update(const Vector3& lambda, const Vector3& xi, double r_
       prox_disk(lambda.tail<2>() - r_T * xi.tail<2>(), mu * lambda_N);
   return {lambda_N, lambda_T(0), lambda_T(1)};
 }
-//! [alart curnier]
+// [alart curnier]
 
-//! [de saxce]
+// [de saxce]
 Vector3 de_saxce_update(const Vector3& lambda, const Vector3& xi, double r, double mu) {
   Vector3 augmented = xi;
   augmented(0) += mu * std::sqrt(xi(1) * xi(1) + xi(2) * xi(2));
   return prox_cone(lambda - r * augmented, mu);
 }
-//! [de saxce]
+// [de saxce]
 
 Vector3 natural_map(const Vector3& lambda, const Vector3& xi, double mu) {
   return lambda - de_saxce_update(lambda, xi, 1.0, mu);
@@ -83,7 +85,7 @@ double natural_map_residual(std::span<const Vector3> lambda, std::span<const Vec
   return std::sqrt(sum);
 }
 
-//! [impact velocity]
+// [impact velocity]
 Vector3 impact_velocity(const Vector3& gamma_E, const Vector3& gamma_A, double eps_N,
                         double eps_T) {
   // EXERCISE 5.4: the velocity of Newton's impact law
@@ -92,27 +94,25 @@ Vector3 impact_velocity(const Vector3& gamma_E, const Vector3& gamma_A, double e
                              "Chapter 5: Prox contact laws and solvers",
                              "exercises/05-contact-laws/prox.cpp");
 }
-//! [impact velocity]
+// [impact velocity]
 
-//! [sor contact update]
+// [sor contact update]
 Vector3 sor_contact_update(const ContactConstraint& c, const RFactors& r, ProxForm form,
                            std::span<const InverseMass> M_inv, std::span<Vector6> u,
                            Vector3& lambda) {
   // EXERCISE 5.7: one SOR contact update
-  // Hint: γ = W_aᵀ u_a − W_bᵀ u_b, skipping a side whose index is kStatic.
-  // Hint: with ProxForm::de_saxce use the smaller of r.r_N and r.r_T as the single r-factor.
-  // Hint: M⁻¹ W Δλ is InverseMass::apply(W Δλ): six numbers per body, no 6 × 6 matrix.
-  // Hint: Δλ = 0 (e.g. an open contact that stays open) leaves the velocities as they are.
+  // Hint: γ = W_aᵀu_a − W_bᵀu_b (skip a kStatic side); De Saxcé takes r = min(r.r_N, r.r_T).
+  // Hint: u_a += M_a⁻¹W_aΔλ, u_b −= M_b⁻¹W_bΔλ with InverseMass::apply; no 6 × 6 matrix.
   throw grbd::NotImplemented("Exercise 5.7", "one SOR contact update",
                              "Chapter 5: Prox contact laws and solvers",
                              "exercises/05-contact-laws/prox.cpp");
 }
-//! [sor contact update]
+// [sor contact update]
 
 // The sweep lives in this file, next to the update it repeats, so that the compiler can inline
 // the update into the loop: `flatten` makes sure it does (on its own GCC keeps the call, and
 // with it the arguments passed through memory).
-//! [sor sweep]
+// [sor sweep]
 [[gnu::flatten]] void sor_sweep(const ContactProblem& problem, std::span<const RFactors> r,
                                 ProxForm form, std::span<Vector6> u, std::span<Vector3> lambda) {
   const std::size_t n = problem.contacts.size();
@@ -141,6 +141,6 @@ Vector3 sor_contact_update(const ContactConstraint& c, const RFactors& r, ProxFo
     sor_contact_update(contacts[i], r[i], form, M_inv, u, lambda[i]);
   }
 }
-//! [sor sweep]
+// [sor sweep]
 
 }  // namespace grbd::contact

@@ -15,36 +15,38 @@
 
 namespace grbd::contact {
 
-//! [delassus block]
+// [delassus block]
 Matrix3 delassus_block(const ContactConstraint& contact, std::span<const InverseMass> M_inv) {
   // EXERCISE 5.5: the Delassus block of one contact
-  // Hint: W_aᵀ M_a⁻¹ W_a = Σ over the columns: apply M⁻¹ to each column of W_a (InverseMass::apply).
+  // Hint: build W_aᵀM_a⁻¹W_a column by column: InverseMass::apply to each column of W_a.
   // Hint: both sides add: the minus sign of W_b appears twice.
   throw grbd::NotImplemented("Exercise 5.5", "the Delassus block of one contact",
                              "Chapter 5: Prox contact laws and solvers",
                              "exercises/05-contact-laws/solver_kernels.cpp");
 }
-//! [delassus block]
+// [delassus block]
 
-//! [r factors]
+// [r factors]
 RFactors r_factors(const Matrix3& G, double alpha) {
   // EXERCISE 5.6: the r-factors of one contact
   // Hint: refuse α ∉ (0, 2) and non-positive (or NaN) diagonal entries with InvalidArgument.
+  // Hint: only the diagonal enters; r_T takes the larger of the two tangential entries.
   throw grbd::NotImplemented("Exercise 5.6", "the r-factors of one contact",
                              "Chapter 5: Prox contact laws and solvers",
                              "exercises/05-contact-laws/solver_kernels.cpp");
 }
-//! [r factors]
+// [r factors]
 
-//! [converged]
+// [converged]
 bool has_converged(std::span<const double> x_old, std::span<const double> x, double abs_tol,
                    double rel_tol) {
   // EXERCISE 5.8: the convergence test of an iteration
   // Hint: a NaN must never count as converged: write the test so that it fails for NaN.
+  // Hint: the relative part scales with |x[k]| of the new iterate, and equality counts.
   throw grbd::NotImplemented("Exercise 5.8", "the convergence test of an iteration",
                              "Chapter 5: Prox contact laws and solvers",
                              "exercises/05-contact-laws/solver_kernels.cpp");
 }
-//! [converged]
+// [converged]
 
 }  // namespace grbd::contact

@@ -9,7 +9,7 @@
 
 namespace grbd::collision {
 
-//! [sphere sphere]
+// [sphere sphere]
 ContactGeometry sphere_sphere(const Vector3& c_a, double r_a, const Vector3& c_b, double r_b) {
   // BEGIN EXERCISE 4.1: the contact of two spheres
   // Hint: the normal is the unit vector along the line of centres, from b towards a.
@@ -25,9 +25,9 @@ ContactGeometry sphere_sphere(const Vector3& c_a, double r_a, const Vector3& c_b
   return contact;
   // END EXERCISE 4.1
 }
-//! [sphere sphere]
+// [sphere sphere]
 
-//! [sphere half space]
+// [sphere half space]
 ContactGeometry sphere_half_space(const Vector3& c, double r, const HalfSpace& half_space) {
   // BEGIN EXERCISE 4.2: the contact of a sphere and a half-space
   // Hint: the signed distance of the centre to the boundary plane is nᵀc − offset.
@@ -41,9 +41,9 @@ ContactGeometry sphere_half_space(const Vector3& c, double r, const HalfSpace& h
   return contact;
   // END EXERCISE 4.2
 }
-//! [sphere half space]
+// [sphere half space]
 
-//! [closest point]
+// [closest point]
 TrianglePoint closest_point_on_triangle(const Vector3& x, const Vector3& a, const Vector3& b,
                                         const Vector3& c) {
   // BEGIN EXERCISE 4.3: the closest point on a triangle
@@ -90,6 +90,6 @@ TrianglePoint closest_point_on_triangle(const Vector3& x, const Vector3& a, cons
   return {a + (vb * denominator) * ab + (vc * denominator) * ac, TriangleFeature::face};
   // END EXERCISE 4.3
 }
-//! [closest point]
+// [closest point]
 
 }  // namespace grbd::collision

@@ -13,10 +13,10 @@
 
 namespace grbd::contact {
 
-//! [delassus block]
+// [delassus block]
 Matrix3 delassus_block(const ContactConstraint& contact, std::span<const InverseMass> M_inv) {
   // BEGIN EXERCISE 5.5: the Delassus block of one contact
-  // Hint: W_aᵀ M_a⁻¹ W_a = Σ over the columns: apply M⁻¹ to each column of W_a (InverseMass::apply).
+  // Hint: build W_aᵀM_a⁻¹W_a column by column: InverseMass::apply to each column of W_a.
   // Hint: both sides add: the minus sign of W_b appears twice.
   Matrix3 G = Matrix3::Zero();
   if (contact.body_a != kStatic) {
@@ -30,12 +30,13 @@ Matrix3 delassus_block(const ContactConstraint& contact, std::span<const Inverse
   return G;
   // END EXERCISE 5.5
 }
-//! [delassus block]
+// [delassus block]
 
-//! [r factors]
+// [r factors]
 RFactors r_factors(const Matrix3& G, double alpha) {
   // BEGIN EXERCISE 5.6: the r-factors of one contact
   // Hint: refuse α ∉ (0, 2) and non-positive (or NaN) diagonal entries with InvalidArgument.
+  // Hint: only the diagonal enters; r_T takes the larger of the two tangential entries.
   if (!(alpha > 0.0 && alpha < 2.0)) {
     throw InvalidArgument("r_factors: the relaxation alpha must lie in (0, 2); found " +
                           format_number(alpha));
@@ -50,19 +51,20 @@ RFactors r_factors(const Matrix3& G, double alpha) {
   return {alpha / G(0, 0), alpha / std::max(G(1, 1), G(2, 2))};
   // END EXERCISE 5.6
 }
-//! [r factors]
+// [r factors]
 
-//! [converged]
+// [converged]
 bool has_converged(std::span<const double> x_old, std::span<const double> x, double abs_tol,
                    double rel_tol) {
   // BEGIN EXERCISE 5.8: the convergence test of an iteration
   // Hint: a NaN must never count as converged: write the test so that it fails for NaN.
+  // Hint: the relative part scales with |x[k]| of the new iterate, and equality counts.
   for (std::size_t k = 0; k < x.size(); ++k) {
     if (!(std::abs(x[k] - x_old[k]) <= abs_tol + rel_tol * std::abs(x[k]))) return false;
   }
   return true;
   // END EXERCISE 5.8
 }
-//! [converged]
+// [converged]
 
 }  // namespace grbd::contact

@@ -75,7 +75,7 @@ Integrator parse_integrator(std::string_view name) {
   throw InvalidArgument(message);
 }
 
-//! [symplectic exp map step]
+// [symplectic exp map step]
 State symplectic_exp_map_step(const RigidBody& body, const State& x, const Loads& loads, double h) {
   require_valid(body, h, "symplectic_exp_map_step");
   // The only change from (a): the velocities are updated first, and q moves with u⁺. For the
@@ -83,9 +83,9 @@ State symplectic_exp_map_step(const RigidBody& body, const State& x, const Loads
   const Vector6 u = x.u + h * newton_euler_u_dot(body, x.u, loads);
   return {kinematics::exp_map_step(x.q, u, h), u};
 }
-//! [symplectic exp map step]
+// [symplectic exp map step]
 
-//! [explicit euler normalized step]
+// [explicit euler normalized step]
 State explicit_euler_normalized_step(const RigidBody& body, const State& x, const Loads& loads,
                                      double h) {
   require_valid(body, h, "explicit_euler_normalized_step");
@@ -96,9 +96,9 @@ State explicit_euler_normalized_step(const RigidBody& body, const State& x, cons
   next.q.tail<4>().normalize();
   return next;
 }
-//! [explicit euler normalized step]
+// [explicit euler normalized step]
 
-//! [lie poisson step]
+// [lie poisson step]
 State lie_poisson_step(const RigidBody& body, const State& x, const Loads& loads, double h) {
   require_valid(body, h, "lie_poisson_step");
   // Strang splitting of H = (kinetic energy of translation) + T₁ + T₂ + T₃ + (the loads): every
@@ -115,9 +115,9 @@ State lie_poisson_step(const RigidBody& body, const State& x, const Loads& loads
   kick(body, loads, 0.5 * h, y);
   return y;
 }
-//! [lie poisson step]
+// [lie poisson step]
 
-//! [implicit gyroscopic step]
+// [implicit gyroscopic step]
 State implicit_gyroscopic_step(const RigidBody& body, const State& x, const Loads& loads,
                                double h) {
   require_valid(body, h, "implicit_gyroscopic_step");
@@ -137,7 +137,7 @@ State implicit_gyroscopic_step(const RigidBody& body, const State& x, const Load
   const Vector6 u = kinematics::make_u(x.u.head<3>() + (h / body.m) * loads.I_F, K_omega_plus);
   return {kinematics::exp_map_step(x.q, u, h), u};
 }
-//! [implicit gyroscopic step]
+// [implicit gyroscopic step]
 
 State step(const RigidBody& body, const State& x, const Loads& loads, double h, Integrator scheme) {
   switch (scheme) {

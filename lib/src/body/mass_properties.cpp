@@ -28,7 +28,7 @@ MassProperties centred(double volume, double density, const Vector3& diagonal_pe
 
 }  // namespace
 
-//! [volume integrals]
+// [volume integrals]
 VolumeIntegrals volume_integrals(const TriangleMesh& mesh) {
   // Divergence theorem: the solid is the signed sum of the tetrahedra (0, a, b, c) over its
   // faces. Their parts outside the solid are covered once positively and once negatively, so
@@ -41,7 +41,7 @@ VolumeIntegrals volume_integrals(const TriangleMesh& mesh) {
   }
   return integrals;
 }
-//! [volume integrals]
+// [volume integrals]
 
 MassProperties mass_properties(const TriangleMesh& mesh, double density, std::string_view source) {
   require_closed_oriented(mesh, source);
@@ -59,7 +59,7 @@ MassProperties mass_properties(const TriangleMesh& mesh, double density, std::st
   return props;
 }
 
-//! [principal axes]
+// [principal axes]
 PrincipalAxes principal_axes(const Matrix3& M_Theta_S) {
   const double size = M_Theta_S.cwiseAbs().maxCoeff();
   const double asymmetry = (M_Theta_S - M_Theta_S.transpose()).cwiseAbs().maxCoeff();
@@ -82,7 +82,7 @@ PrincipalAxes principal_axes(const Matrix3& M_Theta_S) {
   if (axes.A_MK.determinant() < 0.0) axes.A_MK.col(2) *= -1.0;
   return axes;
 }
-//! [principal axes]
+// [principal axes]
 
 MassProperties sphere_mass_properties(double radius, double density) {
   require_positive_finite("sphere_mass_properties", "radius", radius);

@@ -31,7 +31,7 @@ void require_valid(const RigidBody& body, std::string_view where) {
   }
 }
 
-//! [rigid body from mesh]
+// [rigid body from mesh]
 BodyFromMesh rigid_body_from_mesh(const TriangleMesh& mesh, double density,
                                   std::string_view source) {
   // mass_properties() checks the mesh (closed, outward) and the density; Θ_S = A_MK diag(Θ) A_MKᵀ
@@ -43,7 +43,7 @@ BodyFromMesh rigid_body_from_mesh(const TriangleMesh& mesh, double density,
   require_valid(result.body, source);
   return result;
 }
-//! [rigid body from mesh]
+// [rigid body from mesh]
 
 Matrix6 mass_matrix(const RigidBody& body) {
   require_valid(body, "mass_matrix");
@@ -65,7 +65,7 @@ Vector3 I_angular_momentum(const RigidBody& body, const State& x) {
          body.K_Theta.cwiseProduct(kinematics::angular_velocity(x.u));
 }
 
-//! [generalized force]
+// [generalized force]
 Vector6 generalized_force(const Vector7& q, const Vector3& K_rho, const Vector3& I_F) {
   // J_Pᵀ I_F = (I_F, −(A_IK K_ρ̃)ᵀ I_F) = (I_F, K_ρ̃ A_IKᵀ I_F): the force acts on S unchanged and
   // adds the moment K_rho × K_F about S, with the force taken to frame K. Written out rather than
@@ -75,9 +75,9 @@ Vector6 generalized_force(const Vector7& q, const Vector3& K_rho, const Vector3&
   f << I_F, K_rho.cross(K_F);
   return f;
 }
-//! [generalized force]
+// [generalized force]
 
-//! [newton euler u dot]
+// [newton euler u dot]
 Vector6 newton_euler_u_dot(const RigidBody& body, const Vector6& u, const Loads& loads) {
   require_valid(body, "newton_euler_u_dot");
   // M is diagonal in the principal frame: M⁻¹ h is a division per coordinate, no solve.
@@ -86,6 +86,6 @@ Vector6 newton_euler_u_dot(const RigidBody& body, const Vector6& u, const Loads&
   u_dot << h.head<3>() / body.m, h.tail<3>().cwiseQuotient(body.K_Theta);
   return u_dot;
 }
-//! [newton euler u dot]
+// [newton euler u dot]
 
 }  // namespace grbd::body

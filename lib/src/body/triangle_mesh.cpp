@@ -84,7 +84,7 @@ TopologyReport analyse(const TriangleMesh& mesh) {
     }
   }
 
-  //! [require closed oriented]
+  // [require closed oriented]
   // Sort the half-edges so that all traversals of one edge {lo, hi} are adjacent. In a closed,
   // consistently oriented 2-manifold every edge is traversed exactly twice, once in each
   // direction: then the flux terms of the divergence theorem cancel along every edge.
@@ -115,7 +115,7 @@ TopologyReport analyse(const TriangleMesh& mesh) {
     }
     first = last;
   }
-  //! [require closed oriented]
+  // [require closed oriented]
   return report;
 }
 

@@ -101,7 +101,7 @@ std::vector<std::int32_t> morton_order(std::span<const Vector3> centres, double 
   return order;
 }
 
-//! [cell grid build]
+// [cell grid build]
 void CellGrid::build(std::span<const Vector3> centres, std::span<const double> radii,
                      double margin) {
   require_spheres("CellGrid::build", centres, radii, margin);
@@ -159,9 +159,9 @@ void CellGrid::build(std::span<const Vector3> centres, std::span<const double> r
   std::copy_backward(cell_start_.begin(), cell_start_.end() - 1, cell_start_.end());
   cell_start_[0] = 0;
 }
-//! [cell grid build]
+// [cell grid build]
 
-//! [cell grid pairs]
+// [cell grid pairs]
 void CellGrid::find_pairs(std::vector<IndexPair>& pairs) const {
   pairs.clear();
   const std::int32_t nx = dims_.x(), ny = dims_.y(), nz = dims_.z();
@@ -231,7 +231,7 @@ void CellGrid::find_pairs(std::vector<IndexPair>& pairs) const {
   }
   pairs.resize(count);
 }
-//! [cell grid pairs]
+// [cell grid pairs]
 
 std::vector<IndexPair> brute_force_pairs(std::span<const Vector3> centres,
                                          std::span<const double> radii, double margin) {

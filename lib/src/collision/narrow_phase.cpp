@@ -10,7 +10,7 @@
 
 namespace grbd::collision {
 
-//! [sphere box]
+// [sphere box]
 ContactGeometry sphere_box(const Vector3& c, double r, const Box& box,
                            const Placement& box_placement) {
   const Vector3& h = box.half_extents;
@@ -82,7 +82,7 @@ ContactGeometry sphere_box(const Vector3& c, double r, const Box& box,
   contact.I_r_a = c - r * contact.I_n;
   return contact;
 }
-//! [sphere box]
+// [sphere box]
 
 ContactGeometry sphere_capsule(const Vector3& c, double r, const Capsule& capsule,
                                const Placement& capsule_placement) {

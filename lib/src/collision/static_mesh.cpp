@@ -118,7 +118,7 @@ StaticMesh::StaticMesh(body::TriangleMesh mesh) : mesh_(std::move(mesh)) {
   }
 }
 
-//! [bvh query]
+// [bvh query]
 void StaticMesh::query(const Vector3& c, double r, double margin,
                        std::vector<std::int32_t>& triangles) const {
   const Vector3 reach = Vector3::Constant(r + margin);
@@ -145,7 +145,7 @@ void StaticMesh::query(const Vector3& c, double r, double margin,
     }
   }
 }
-//! [bvh query]
+// [bvh query]
 
 namespace {
 
@@ -183,7 +183,7 @@ bool in_vertex_region(const StaticMesh& mesh, std::int32_t v, const Vector3& n) 
 
 }  // namespace
 
-//! [sphere mesh]
+// [sphere mesh]
 void sphere_mesh(const Vector3& c, double r, const StaticMesh& mesh, double margin,
                  std::vector<ContactGeometry>& out) {
   const body::TriangleMesh& m = mesh.mesh();
@@ -255,6 +255,6 @@ void sphere_mesh(const Vector3& c, double r, const StaticMesh& mesh, double marg
     out.push_back(contact);
   }
 }
-//! [sphere mesh]
+// [sphere mesh]
 
 }  // namespace grbd::collision

@@ -124,7 +124,7 @@ std::int32_t CollisionWorld::add(Collider collider) {
   return index;
 }
 
-//! [detect]
+// [detect]
 void CollisionWorld::detect(std::span<const body::State> states, double margin,
                             std::vector<Contact>& contacts) {
   contacts.clear();
@@ -264,6 +264,6 @@ void CollisionWorld::detect(std::span<const body::State> states, double margin,
     }
   }
 }
-//! [detect]
+// [detect]
 
 }  // namespace grbd::collision

@@ -9,7 +9,7 @@
 
 namespace grbd::kinematics {
 
-//! [log SO3]
+// [log SO3]
 Vector3 log_SO3(const Matrix3& R) {
   if (!R.allFinite()) {
     throw InvalidArgument("log_SO3: the rotation matrix R has a NaN or infinite entry");
@@ -18,14 +18,14 @@ Vector3 log_SO3(const Matrix3& R) {
   // Shepperd's method and the atan2-based logarithm are both accurate at every angle.
   return rotation_vector(quaternion_from_rotation_matrix(R));
 }
-//! [log SO3]
+// [log SO3]
 
 Quaternion quaternion_from_rotation_vector(const Vector3& theta) {
   // p = (cos(θ/2), sin(θ/2) n): the quaternion turns by half the angle, the sandwich doubles it.
   return exp_S3(0.5 * theta);
 }
 
-//! [rotation vector]
+// [rotation vector]
 Vector3 rotation_vector(const Quaternion& p) {
   if (!(p.squared_norm() > 0.0)) {
     throw InvalidArgument(
@@ -36,6 +36,6 @@ Vector3 rotation_vector(const Quaternion& p) {
   // |log p| ≤ π/2, hence |θ| = 2|log p| ≤ π, the principal rotation vector.
   return 2.0 * log_S3(p.p0() < 0.0 ? -p : p);
 }
-//! [rotation vector]
+// [rotation vector]
 
 }  // namespace grbd::kinematics

@@ -32,7 +32,7 @@ Quaternion Quaternion::normalized() const {
   return Quaternion(Vector4(K_ / n));
 }
 
-//! [complex matrix]
+// [complex matrix]
 Eigen::Matrix2cd complex_matrix(const Quaternion& P) {
   using C = std::complex<double>;
   // 1, i, j, k ↦ I, diag(i, −i), [[0, 1], [−1, 0]], [[0, i], [i, 0]]: these four matrices obey
@@ -42,7 +42,7 @@ Eigen::Matrix2cd complex_matrix(const Quaternion& P) {
       C(-P[2], P[3]), C(P[0], -P[1]);
   return M;
 }
-//! [complex matrix]
+// [complex matrix]
 
 Quaternion from_complex_matrix(const Eigen::Matrix2cd& M) {
   // The first row alone determines P: M(0,0) = p0 + i p1, M(0,1) = p2 + i p3.

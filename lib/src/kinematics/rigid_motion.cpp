@@ -29,21 +29,21 @@ Vector3 point_position(const Vector7& q, const Vector3& K_rho) {
   return body_motion(orientation(q), position(q), K_rho);
 }
 
-//! [explicit euler step]
+// [explicit euler step]
 Vector7 explicit_euler_step(const Vector7& q, const Vector6& u, double h) {
   // A straight step in ℝ⁷ along the tangent F(q) u. Since pᵀṗ = 0 the step is orthogonal to p,
   // so by Pythagoras |p|² grows to |p|² + h²|ṗ|² = |p|² (1 + h²|K_omega|²/4): the drift.
   return q + h * q_dot(q, u);
 }
-//! [explicit euler step]
+// [explicit euler step]
 
-//! [exp map step]
+// [exp map step]
 Vector7 exp_map_step(const Vector7& q, const Vector6& u, double h) {
   // For constant K_omega, ṗ = ½ p (0, K_omega) is solved by p(t) = p(0) exp_S3(t K_omega / 2):
   // the step multiplies by a unit quaternion, so it stays on S³ and is exact.
   const Quaternion p = orientation(q) * exp_S3(0.5 * h * angular_velocity(u));
   return make_q(position(q) + h * linear_velocity(u), p);
 }
-//! [exp map step]
+// [exp map step]
 
 }  // namespace grbd::kinematics

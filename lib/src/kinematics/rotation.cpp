@@ -13,7 +13,7 @@
 
 namespace grbd::kinematics {
 
-//! [sandwich]
+// [sandwich]
 Vector3 sandwich(const Quaternion& P, const Vector3& x) {
   if (!(P.squared_norm() > 0.0)) {
     throw InvalidArgument(
@@ -24,7 +24,7 @@ Vector3 sandwich(const Quaternion& P, const Vector3& x) {
   // round-off, so only the vector part is returned. P⁻¹ = P̄/|P|² cancels the scale |P|².
   return (P * Quaternion::pure(x) * P.inverse()).p_r();
 }
-//! [sandwich]
+// [sandwich]
 
 Vector3 body_motion(const Quaternion& P, const Vector3& r, const Vector3& rho) {
   // P ρ P̄ = |P|² R(P/|P|) ρ, and rotation_matrix(P) is exactly that matrix for any P: no

@@ -65,7 +65,7 @@ EulerTop euler_top(const Vector3& K_Theta, const Vector3& K_omega0) {
         "Θ1 < Θ2 < Θ3, but K_Theta = " +
         format_vector(K_Theta));
   }
-  //! [euler top]
+  // [euler top]
   const double T1 = K_Theta[0];
   const double T2 = K_Theta[1];
   const double T3 = K_Theta[2];
@@ -103,7 +103,7 @@ EulerTop euler_top(const Vector3& K_Theta, const Vector3& K_omega0) {
   }
   top.t0 = -tau0 / top.lambda;  // τ = λ(t − t0) = τ0 at t = 0
   top.period = 4.0 * boost::math::ellint_1(k) / top.lambda;
-  //! [euler top]
+  // [euler top]
   return top;
 }
 

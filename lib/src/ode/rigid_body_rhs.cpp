@@ -73,7 +73,7 @@ RhsFunction heavy_top(const HeavyTop& top) {
     throw InvalidArgument("heavy_top: l and g must be finite and >= 0, but l = " +
                           format_number(top.l) + " and g = " + format_number(top.g));
   }
-  //! [heavy top rhs]
+  // [heavy top rhs]
   // Θ_O: Steiner's theorem moves the transverse moments from S to O, a distance l along e3.
   const double I1_O = top.I1 + top.m * top.l * top.l;
   const Vector3 Theta_O(I1_O, I1_O, top.I3);
@@ -94,7 +94,7 @@ RhsFunction heavy_top(const HeavyTop& top) {
     const Vector3 K_L_O = Theta_O.cwiseProduct(K_omega);
     y_dot.tail<3>() = (K_r_OS.cross(K_F) - K_omega.cross(K_L_O)).cwiseQuotient(Theta_O);
   };
-  //! [heavy top rhs]
+  // [heavy top rhs]
 }
 
 ProjectionFunction quaternion_projection_at(Eigen::Index offset) {

@@ -96,7 +96,7 @@ Eigen::Map<Eigen::VectorXd> view(N_Vector v) {
 // The C callbacks
 // ---------------------------------------------------------------------------------------------
 
-//! [error handler]
+// [error handler]
 /// What the C callbacks reach through SUNDIALS' user_data: the user's functions, the exception
 /// one of them threw, and the message of SUNDIALS' error handler.
 struct Callbacks {
@@ -164,9 +164,9 @@ int implicit_rhs_callback(sunrealtype t, N_Vector y, N_Vector y_dot, void* user_
   auto& callbacks = *static_cast<Callbacks*>(user_data);
   return call_rhs(callbacks.f_implicit, callbacks, t, y, y_dot);
 }
-//! [error handler]
+// [error handler]
 
-//! [projection callback]
+// [projection callback]
 /// CVODE's projection (CVProjFn): after each accepted step CVODE hands over the new solution y
 /// and applies y ← y + correction. The correction arrives zeroed, so the user's function needs
 /// to write only the entries it changes. The error estimate is not projected (CVodeSetProjErrEst
@@ -186,7 +186,7 @@ int projection_callback(sunrealtype t, N_Vector y, N_Vector correction, sunrealt
     return -1;  // CV_PROJFUNC_FAIL: unrecoverable
   }
 }
-//! [projection callback]
+// [projection callback]
 
 // ---------------------------------------------------------------------------------------------
 // Input validation
@@ -405,7 +405,7 @@ void Cvode::set_max_steps(long max_steps) {
   impl_->check("CVodeSetMaxNumSteps", [&] { return CVodeSetMaxNumSteps(mem, max_steps); });
 }
 
-//! [cvode advance]
+// [cvode advance]
 Eigen::VectorXd Cvode::advance(double t_out) {
   Impl& s = *impl_;
   s.require_output_time(t_out, "Cvode::advance");
@@ -425,7 +425,7 @@ Eigen::VectorXd Cvode::advance(double t_out) {
   }
   return y;
 }
-//! [cvode advance]
+// [cvode advance]
 
 double Cvode::time() const { return impl_->t; }
 

@@ -44,7 +44,7 @@ std::string_view integrator_name(Integrator scheme);
 /// for any other string.
 Integrator parse_integrator(std::string_view name);
 
-//! [explicit exp map declaration]
+// [explicit exp map declaration]
 /// \brief <b>Exercise 2.5</b>: one step of the lecture's scheme (explicit velocity update and
 /// exponential-map orientation update).
 ///
@@ -54,7 +54,7 @@ Integrator parse_integrator(std::string_view name);
 ///     p^+ = p\,\exp_{S^3}(\tfrac h2\,\boldsymbol\omega). \f]
 /// First order; |p| stays 1 to round-off.
 State explicit_exp_map_step(const RigidBody& body, const State& x, const Loads& loads, double h);
-//! [explicit exp map declaration]
+// [explicit exp map declaration]
 
 /// (b) Semi-implicit (symplectic) Euler with the exponential map: u⁺ = u + h M⁻¹ h(u), then
 /// r⁺ = r + h v⁺, p⁺ = p exp_S3(h ω⁺/2). First order. Euler's equations do not involve q, so for
@@ -68,7 +68,7 @@ State symplectic_exp_map_step(const RigidBody& body, const State& x, const Loads
 State explicit_euler_normalized_step(const RigidBody& body, const State& x, const Loads& loads,
                                      double h);
 
-//! [free rotation declaration]
+// [free rotation declaration]
 /// \brief <b>Exercise 2.6</b>: the exact free rotation about one principal axis.
 ///
 /// The exact flow, over time t, of the part T_i = L_i²/(2Θ_i) of the kinetic energy, with
@@ -77,7 +77,7 @@ State explicit_euler_normalized_step(const RigidBody& body, const State& x, cons
 /// of L turn the opposite way, L⁺ = exp_SO3(−t φ̇ e_i) L; K_omega⁺ = Θ⁻¹ L⁺. Position and
 /// velocity of S are unchanged. axis ∈ {0, 1, 2}.
 State free_rotation_about_axis(const RigidBody& body, const State& x, int axis, double t);
-//! [free rotation declaration]
+// [free rotation declaration]
 
 /// (d) Symmetric Lie–Poisson splitting (McLachlan 1993; Dullweber, Leimkuhler, McLachlan 1997):
 /// a half kick with the loads, then the free rotations R₁(h/2) R₂(h/2) R₃(h) R₂(h/2) R₁(h/2) and

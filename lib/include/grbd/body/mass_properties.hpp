@@ -23,7 +23,7 @@ struct VolumeIntegrals {
   }
 };
 
-//! [tetrahedron integrals declaration]
+// [tetrahedron integrals declaration]
 /// \brief <b>Exercise 2.1</b>: the volume integrals of one surface triangle.
 ///
 /// The signed integrals over the tetrahedron with vertices 0, a, b, c (3 × 1 each, frame M), which
@@ -36,13 +36,13 @@ struct VolumeIntegrals {
 ///     \quad \mathbf s = \mathbf a+\mathbf b+\mathbf c. \f]
 /// V is negative when (a, b, c) turns clockwise seen from the origin.
 VolumeIntegrals tetrahedron_integrals(const Vector3& a, const Vector3& b, const Vector3& c);
-//! [tetrahedron integrals declaration]
+// [tetrahedron integrals declaration]
 
 /// The volume integrals of the solid bounded by a closed, outward-oriented mesh: the sum of
 /// tetrahedron_integrals() over its faces (exact for the polyhedron, up to round-off).
 VolumeIntegrals volume_integrals(const TriangleMesh& mesh);
 
-//! [inertia declaration]
+// [inertia declaration]
 /// \brief <b>Exercise 2.2</b>: the inertia tensor about the centre of mass.
 ///
 /// For uniform density ρ: m = ρV, r_S = (∫x dV)/V, the inertia about the origin
@@ -51,7 +51,7 @@ VolumeIntegrals volume_integrals(const TriangleMesh& mesh);
 ///     - \mathbf r_S\mathbf r_S^\mathsf{T}). \f]
 /// Returns Θ_S (3 × 3, symmetric, frame M) [kg m²]; integrals.volume must not be zero.
 Matrix3 inertia_about_centre_of_mass(const VolumeIntegrals& integrals, double density);
-//! [inertia declaration]
+// [inertia declaration]
 
 /// Mass properties of a solid in its own frame M.
 struct MassProperties {

@@ -56,7 +56,7 @@ double kinetic_energy(const RigidBody& body, const Vector6& u);
 /// constant for a torque-free body.
 Vector3 I_angular_momentum(const RigidBody& body, const State& x);
 
-//! [point jacobian declaration]
+// [point jacobian declaration]
 /// \brief <b>Exercise 2.3</b>: the Jacobian of a material point.
 ///
 /// The 3 × 6 matrix J_P(q) with I_v_P = J_P u for the material point at body-fixed offset K_rho
@@ -65,13 +65,13 @@ Vector3 I_angular_momentum(const RigidBody& body, const State& x);
 ///     \end{pmatrix}. \f]
 /// Its transpose maps a force I_F at P to the generalized force J_Pᵀ I_F = (I_F, K_rho × A_IKᵀ I_F).
 Matrix36 point_jacobian(const Vector7& q, const Vector3& K_rho);
-//! [point jacobian declaration]
+// [point jacobian declaration]
 
 /// The generalized force J_P(q)ᵀ I_F (6 × 1) of a force I_F [N] (frame I) at the material point
 /// K_rho.
 Vector6 generalized_force(const Vector7& q, const Vector3& K_rho, const Vector3& I_F);
 
-//! [newton euler declaration]
+// [newton euler declaration]
 /// \brief <b>Exercise 2.4</b>: the right-hand side of the Newton–Euler equations.
 ///
 /// M u̇ = h with
@@ -80,7 +80,7 @@ Vector6 generalized_force(const Vector7& q, const Vector3& K_rho, const Vector3&
 /// (6 × 1): Newton's law for S in frame I and Euler's equations in the body frame with the
 /// gyroscopic term. Θ = diag(K_Theta).
 Vector6 newton_euler_h(const RigidBody& body, const Vector6& u, const Loads& loads);
-//! [newton euler declaration]
+// [newton euler declaration]
 
 /// The acceleration u̇ = M⁻¹ h (6 × 1).
 Vector6 newton_euler_u_dot(const RigidBody& body, const Vector6& u, const Loads& loads);

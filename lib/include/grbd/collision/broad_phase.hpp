@@ -15,14 +15,14 @@ namespace grbd::collision {
 /// A candidate pair of spheres (i < j).
 using IndexPair = std::pair<std::int32_t, std::int32_t>;
 
-//! [morton declaration]
+// [morton declaration]
 /// \brief <b>Exercise 4.6</b>: the Morton code of a grid cell.
 ///
 /// Interleaves the bits of the cell coordinates, bit b of i, j, k going to bits 3b, 3b + 1,
 /// 3b + 2 of the code, for i, j, k < 2²¹ (else grbd::InvalidArgument): cells close in space get
 /// close codes (Z-order curve).
 std::uint64_t morton_code(std::uint32_t i, std::uint32_t j, std::uint32_t k);
-//! [morton declaration]
+// [morton declaration]
 
 /// The permutation that sorts the points by the Morton code of their cell of size `cell_size`
 /// (relative to the points' bounding box): order[n] is the index of the n-th point in Z-order,

@@ -81,7 +81,7 @@ struct Contact {
   }
 };
 
-//! [tangent basis declaration]
+// [tangent basis declaration]
 /// \brief <b>Exercise 4.4</b>: a tangent basis of the contact plane.
 ///
 /// Unit vectors t1, t2 with (n, t1, t2) orthonormal and right-handed (t2 = n × t1), for a unit
@@ -89,14 +89,14 @@ struct Contact {
 /// continuous tangent field on S² exists), and accurate near that point (Frisvad 2012; Duff et
 /// al. 2017). Returns the 3 × 2 matrix [t1 t2].
 Eigen::Matrix<double, 3, 2> tangent_basis(const Vector3& n);
-//! [tangent basis declaration]
+// [tangent basis declaration]
 
 /// The generalized force directions of one contact for one body (6 × 3), in u = (I_v_S, K_omega):
 /// columns W_N, W_T1, W_T2, such that the body's share of the relative contact velocity is
 /// (γ_N, γ_T1, γ_T2) = Wᵀ u.
 using ContactJacobian = Eigen::Matrix<double, 6, 3>;
 
-//! [contact jacobian declaration]
+// [contact jacobian declaration]
 /// \brief <b>Exercise 4.5</b>: the contact Jacobian of one body.
 ///
 /// For the material point at K_rho of the body with orientation p (unit quaternion) and the
@@ -106,6 +106,6 @@ using ContactJacobian = Eigen::Matrix<double, 6, 3>;
 /// contact frame, and γ_N = ġ_N.
 ContactJacobian contact_jacobian(const kinematics::Quaternion& p, const Vector3& K_rho,
                                  const Vector3& I_n, const Vector3& I_t1, const Vector3& I_t2);
-//! [contact jacobian declaration]
+// [contact jacobian declaration]
 
 }  // namespace grbd::collision

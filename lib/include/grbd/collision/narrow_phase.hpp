@@ -19,21 +19,21 @@ struct Placement {
   Matrix3 A_IC = Matrix3::Identity();  ///< orientation of C: x_I = I_r + A_IC x_C
 };
 
-//! [sphere sphere declaration]
+// [sphere sphere declaration]
 /// \brief <b>Exercise 4.1</b>: the contact of two spheres.
 ///
 /// Centres c_a, c_b, radii r_a, r_b: n = (c_a − c_b)/|c_a − c_b|, g_N = |c_a − c_b| − r_a − r_b,
 /// r_a = c_a − r_a n, r_b = c_b + r_b n. For coincident centres the normal is e_z (any direction
 /// is correct; a fixed one keeps the result deterministic).
 ContactGeometry sphere_sphere(const Vector3& c_a, double r_a, const Vector3& c_b, double r_b);
-//! [sphere sphere declaration]
+// [sphere sphere declaration]
 
-//! [sphere half space declaration]
+// [sphere half space declaration]
 /// \brief <b>Exercise 4.2</b>: the contact of a sphere (a) with a half-space (b).
 ///
 /// n = I_n of the half-space, g_N = nᵀc − offset − r, r_a = c − r n, r_b = c − (nᵀc − offset) n.
 ContactGeometry sphere_half_space(const Vector3& c, double r, const HalfSpace& half_space);
-//! [sphere half space declaration]
+// [sphere half space declaration]
 
 /// Which feature of a triangle (a, b, c) is closest to a point.
 enum class TriangleFeature : std::uint8_t {
@@ -48,7 +48,7 @@ struct TrianglePoint {
   TriangleFeature feature = TriangleFeature::face;  ///< where it lies
 };
 
-//! [closest point declaration]
+// [closest point declaration]
 /// \brief <b>Exercise 4.3</b>: the closest point on a triangle.
 ///
 /// The point of the triangle (a, b, c) closest to x, by the Voronoi regions of its vertices, edges
@@ -56,7 +56,7 @@ struct TrianglePoint {
 /// including points exactly on an edge or a vertex.
 TrianglePoint closest_point_on_triangle(const Vector3& x, const Vector3& a, const Vector3& b,
                                         const Vector3& c);
-//! [closest point declaration]
+// [closest point declaration]
 
 /// A sphere (a) against a box (b) placed by `box_placement`: the closest point of the solid box;
 /// a centre inside the box is pushed out through the nearest face. feature_b encodes the face,

@@ -60,9 +60,9 @@ class StaticMesh {
 /// (nᵀ(x_w − x_v) ≤ τ|x_w − x_v|), τ = 1e-9. Otherwise the contact belongs to a neighbouring
 /// face or edge, which reports it. A centre exactly on the mesh takes the normal of the face
 /// ((b − a) × (c − a) normalised) of the first triangle that reports the feature.
-//! [sphere mesh declaration]
+// [sphere mesh declaration]
 void sphere_mesh(const Vector3& c, double r, const StaticMesh& mesh, double margin,
                  std::vector<ContactGeometry>& out);
-//! [sphere mesh declaration]
+// [sphere mesh declaration]
 
 }  // namespace grbd::collision

@@ -75,23 +75,23 @@ struct ContactProblem {
 /// length.
 void validate(const ContactProblem& problem);
 
-//! [impact velocity declaration]
+// [impact velocity declaration]
 /// \brief <b>Exercise 5.4</b>: the velocity of Newton's impact law.
 ///
 /// ξ = γ_E + ε ∘ γ_A with ε = (ε_N, ε_T, ε_T): the contact velocity at the end of the step plus
 /// the restituted part of the one at the beginning. The contact law is stated for ξ, so that
 /// a closing contact (γ_N,A < 0) leaves with γ_N,E = −ε_N γ_N,A.
 Vector3 impact_velocity(const Vector3& gamma_E, const Vector3& gamma_A, double eps_N, double eps_T);
-//! [impact velocity declaration]
+// [impact velocity declaration]
 
-//! [delassus block declaration]
+// [delassus block declaration]
 /// \brief <b>Exercise 5.5</b>: the Delassus block of one contact.
 ///
 /// G_ii = W_aᵀ M_a⁻¹ W_a + W_bᵀ M_b⁻¹ W_b (3 × 3, symmetric positive semidefinite): how the
 /// contact velocity ξ_i responds to its own percussion λ_i. A static side (index kStatic)
 /// contributes nothing. `M_inv` is indexed by body.
 Matrix3 delassus_block(const ContactConstraint& contact, std::span<const InverseMass> M_inv);
-//! [delassus block declaration]
+// [delassus block declaration]
 
 /// The r-factors of one contact: r_N for the normal, r_T for the tangential prox.
 struct RFactors {
@@ -105,7 +105,7 @@ enum class ProxForm {
   de_saxce,       ///< one projection onto the cone with the augmented velocity, r = min(r_N, r_T)
 };
 
-//! [sor contact update declaration]
+// [sor contact update declaration]
 /// \brief <b>Exercise 5.7</b>: one SOR contact update.
 ///
 /// For contact `c`: the impact-law velocity ξ = impact_velocity(W_aᵀ u_a − W_bᵀ u_b, γ_A, ε_N,
@@ -116,7 +116,7 @@ enum class ProxForm {
 Vector3 sor_contact_update(const ContactConstraint& c, const RFactors& r, ProxForm form,
                            std::span<const InverseMass> M_inv, std::span<Vector6> u,
                            Vector3& lambda);
-//! [sor contact update declaration]
+// [sor contact update declaration]
 
 /// The end velocities u = u_free + M⁻¹ W Λ for percussions Λ (one λ per contact).
 std::vector<Vector6> velocities_from_percussions(const ContactProblem& problem,

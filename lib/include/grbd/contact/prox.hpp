@@ -15,31 +15,31 @@
 
 namespace grbd::contact {
 
-//! [prox nonnegative declaration]
+// [prox nonnegative declaration]
 /// \brief <b>Exercise 5.1</b>: the prox onto ℝ₊.
 ///
 /// prox_ℝ₊(x) = argmin_{y ≥ 0} |y − x| = max(x, 0): the unilateral contact law
 /// −ξ_N ∈ N_ℝ₊(λ_N) is equivalent to λ_N = prox_ℝ₊(λ_N − r ξ_N) for every r > 0.
 double prox_nonnegative(double x);
-//! [prox nonnegative declaration]
+// [prox nonnegative declaration]
 
-//! [prox disk declaration]
+// [prox disk declaration]
 /// \brief <b>Exercise 5.2</b>: the prox onto the disk of radius ρ.
 ///
 /// The point of C_T = {y ∈ ℝ² : ‖y‖ ≤ ρ} closest to x: x itself when ‖x‖ ≤ ρ, otherwise
 /// ρ x/‖x‖. With ρ = μ λ_N this is the prox of spatial Coulomb friction. ρ ≥ 0; for ρ = 0 the
 /// result is 0.
 Vector2 prox_disk(const Vector2& x, double radius);
-//! [prox disk declaration]
+// [prox disk declaration]
 
-//! [prox cone declaration]
+// [prox cone declaration]
 /// \brief <b>Exercise 5.3</b>: the prox onto the Coulomb cone.
 ///
 /// The Euclidean projection of x = (x_N, x_T) onto K_μ = {‖y_T‖ ≤ μ y_N}, μ ≥ 0: x itself when
 /// x ∈ K_μ; 0 when x lies in the polar cone (μ ‖x_T‖ ≤ −x_N); otherwise the point of the cone's
 /// surface y_N = (x_N + μ ‖x_T‖)/(1 + μ²), y_T = μ y_N x_T/‖x_T‖.
 Vector3 prox_cone(const Vector3& x, double mu);
-//! [prox cone declaration]
+// [prox cone declaration]
 
 /// The Alart–Curnier prox update of one contact, normal first, then tangential:
 /// λ_N⁺ = prox_ℝ₊(λ_N − r_N ξ_N), λ_T⁺ = prox_disk(μ λ_N⁺)(λ_T − r_T ξ_T). A fixed point of this

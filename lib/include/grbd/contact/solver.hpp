@@ -15,7 +15,7 @@
 
 namespace grbd::contact {
 
-//! [r factors declaration]
+// [r factors declaration]
 /// \brief <b>Exercise 5.6</b>: the r-factors of one contact.
 ///
 /// r_N = α / G_NN and r_T = α / max(G_T1T1, G_T2T2) for the Delassus block G (normal first) and
@@ -25,9 +25,9 @@ namespace grbd::contact {
 /// λ_max(D⁻¹G) ≤ 3, α < 2/3 is always safe. Throws InvalidArgument if a diagonal entry of G is
 /// not positive or α is outside (0, 2).
 RFactors r_factors(const Matrix3& G, double alpha);
-//! [r factors declaration]
+// [r factors declaration]
 
-//! [converged declaration]
+// [converged declaration]
 /// \brief <b>Exercise 5.8</b>: the convergence test of an iteration.
 ///
 /// True when every component k satisfies |x_k − x_old,k| ≤ abs_tol + rel_tol |x_k|, the mixed
@@ -35,7 +35,7 @@ RFactors r_factors(const Matrix3& G, double alpha);
 /// arrays have the same length.
 bool has_converged(std::span<const double> x_old, std::span<const double> x, double abs_tol,
                    double rel_tol);
-//! [converged declaration]
+// [converged declaration]
 
 /// How a solver picks the r-factors.
 enum class RFactorStrategy {
@@ -96,13 +96,13 @@ struct ContactSolution {
 std::vector<RFactors> r_factors(const ContactProblem& problem, RFactorStrategy strategy,
                                 double alpha);
 
-//! [sor sweep declaration]
+// [sor sweep declaration]
 /// One Gauss–Seidel sweep: sor_contact_update() for contacts 0, 1, …, n − 1 in order, each
 /// seeing the velocities its predecessors left. The hot loop of SOR, exposed for benchmarks and
 /// for the parallel solver of chapter 8.
 void sor_sweep(const ContactProblem& problem, std::span<const RFactors> r, ProxForm form,
                std::span<Vector6> u, std::span<Vector3> lambda);
-//! [sor sweep declaration]
+// [sor sweep declaration]
 
 /// \name Body-form solvers
 /// Each validates the problem and the options first (InvalidArgument), then iterates.

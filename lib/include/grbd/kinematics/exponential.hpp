@@ -8,7 +8,7 @@
 
 namespace grbd::kinematics {
 
-//! [exp declaration]
+// [exp declaration]
 /// \brief <b>Exercise 1.5</b>: the exponential on S³.
 ///
 /// The quaternion exponential of the pure quaternion (0, v), v ∈ ℝ³:
@@ -17,9 +17,9 @@ namespace grbd::kinematics {
 /// accurate to round-off also for |v| → 0 (where sin|v|/|v| → 1). The rotation by the rotation
 /// vector θ is exp_S3(θ/2).
 Quaternion exp_S3(const Vector3& v);
-//! [exp declaration]
+// [exp declaration]
 
-//! [log declaration]
+// [log declaration]
 /// \brief <b>Exercise 1.6</b>: the logarithm on S³.
 ///
 /// The principal logarithm on S³: the v ∈ ℝ³ with |v| ∈ [0, π] and
@@ -28,9 +28,9 @@ Quaternion exp_S3(const Vector3& v);
 /// Accurate near p = 1 (|v| → 0) and near p = −1 (|v| → π); at p = −1 exactly every axis is a
 /// logarithm and π e_x is returned.
 Vector3 log_S3(const Quaternion& p);
-//! [log declaration]
+// [log declaration]
 
-//! [rodrigues declaration]
+// [rodrigues declaration]
 /// \brief <b>Exercise 1.7</b>: Rodrigues' formula, the exponential on SO(3).
 ///
 /// Rodrigues' formula: the exponential on SO(3) of the rotation vector θ,
@@ -38,7 +38,7 @@ Vector3 log_S3(const Quaternion& p);
 ///     + \frac{1 - \cos\theta}{\theta^2}\,\tilde{\boldsymbol\theta}^2, \qquad \theta = |\boldsymbol\theta|, \f]
 /// the rotation by the angle θ about θ/|θ| (3 × 3), accurate to round-off also for θ → 0.
 Matrix3 exp_SO3(const Vector3& theta);
-//! [rodrigues declaration]
+// [rodrigues declaration]
 
 /// The principal logarithm on SO(3): the rotation vector θ, |θ| ∈ [0, π], with exp_SO3(θ) = R.
 Vector3 log_SO3(const Matrix3& R);

@@ -72,7 +72,7 @@ inline Quaternion operator*(Quaternion P, double s) { return P *= s; }
 /// The real multiple s P.
 inline Quaternion operator*(double s, Quaternion P) { return P *= s; }
 
-//! [product declaration]
+// [product declaration]
 /// \brief <b>Exercise 1.1</b>: the quaternion product.
 ///
 /// The quaternion product P Q (Hamilton's product), in coordinates
@@ -80,12 +80,12 @@ inline Quaternion operator*(double s, Quaternion P) { return P *= s; }
 ///     \\ p_0\,\mathbf q_r + q_0\,\mathbf p_r + \mathbf p_r \times \mathbf q_r \end{pmatrix}. \f]
 /// Associative and distributive, not commutative; |PQ| = |P| |Q|.
 Quaternion product(const Quaternion& P, const Quaternion& Q);
-//! [product declaration]
+// [product declaration]
 
 /// The quaternion product P Q; see product().
 inline Quaternion operator*(const Quaternion& P, const Quaternion& Q) { return product(P, Q); }
 
-//! [phi declaration]
+// [phi declaration]
 /// \brief <b>Exercise 1.2</b>: the multiplication matrices φ_L and φ_R.
 ///
 /// The left multiplication matrix φ_L(P) (4 × 4): K(PQ) = φ_L(P) K(Q),
@@ -100,7 +100,7 @@ Matrix4 phi_L(const Quaternion& P);
 ///     \\ \mathbf q_r & q_0 \mathbf I - \tilde{\mathbf q}_r \end{pmatrix}. \f]
 /// Associativity of ℍ is the commutation φ_L(P) φ_R(Q) = φ_R(Q) φ_L(P).
 Matrix4 phi_R(const Quaternion& Q);
-//! [phi declaration]
+// [phi declaration]
 
 /// The 2 × 2 complex matrix of P in the basis (I, i, j, k) of ℍ ⊂ ℂ²ˣ²:
 /// \f[ P \mapsto \begin{pmatrix} p_0 + \mathrm i p_1 & p_2 + \mathrm i p_3

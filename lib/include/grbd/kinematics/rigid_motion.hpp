@@ -23,7 +23,7 @@ inline Vector3 linear_velocity(const Vector6& u) { return u.head<3>(); }
 /// K_omega, the last three coordinates of u.
 inline Vector3 angular_velocity(const Vector6& u) { return u.tail<3>(); }
 
-//! [kinematic map declaration]
+// [kinematic map declaration]
 /// \brief <b>Exercise 1.8</b>: the kinematic map F(q).
 ///
 /// The kinematic map F(q) (7 × 6) with q̇ = F(q) u:
@@ -32,7 +32,7 @@ inline Vector3 angular_velocity(const Vector6& u) { return u.tail<3>(); }
 ///     \mathbf E = \begin{pmatrix} \mathbf 0^\mathsf{T} \\ \mathbf I_3 \end{pmatrix} \in \mathbb R^{4\times 3}, \f]
 /// that is İ_r_S = I_v_S and ṗ = ½ p (0, K_ω). F(q)ᵀ F(q) = diag(I₃, ¼|p|² I₃), and pᵀ ṗ = 0.
 Matrix76 kinematic_map(const Vector7& q);
-//! [kinematic map declaration]
+// [kinematic map declaration]
 
 /// q̇ = F(q) u (7 × 1).
 Vector7 q_dot(const Vector7& q, const Vector6& u);
@@ -41,13 +41,13 @@ Vector7 q_dot(const Vector7& q, const Vector6& u);
 /// the centre of mass (3 × 1, frame I). A_IK = R(p) for the unit quaternion p of q.
 Vector3 point_position(const Vector7& q, const Vector3& K_rho);
 
-//! [point velocity declaration]
+// [point velocity declaration]
 /// \brief <b>Exercise 1.9</b>: the velocity of a material point.
 ///
 /// The velocity of the material point P at body-fixed offset K_rho (3 × 1,
 /// frame I): \f$ {}_I\mathbf v_P = {}_I\mathbf v_S + \mathbf A_{IK}\,({}_K\boldsymbol\omega \times {}_K\boldsymbol\rho) \f$.
 Vector3 point_velocity(const Vector7& q, const Vector6& u, const Vector3& K_rho);
-//! [point velocity declaration]
+// [point velocity declaration]
 
 /// One explicit Euler step q ← q + h F(q) u for constant u. It leaves the unit sphere: the step
 /// multiplies |p|² by exactly 1 + h²|K_omega|²/4.

@@ -8,7 +8,7 @@
 
 namespace grbd::kinematics {
 
-//! [rotation matrix declaration]
+// [rotation matrix declaration]
 /// \brief <b>Exercise 1.3</b>: the rotation matrix R(p).
 ///
 /// The matrix of the map x ↦ p x p̄ on pure quaternions (3 × 3),
@@ -18,7 +18,7 @@ namespace grbd::kinematics {
 /// body frame K); for any p it equals |p|² R(p/|p|), the linear part of the scalable body motion.
 /// R(p) = R(−p): p and −p are the same rotation.
 Matrix3 rotation_matrix(const Quaternion& p);
-//! [rotation matrix declaration]
+// [rotation matrix declaration]
 
 /// The sandwich x ↦ P x P⁻¹ of E³ for any P ≠ 0 (3 × 1 in and out, same frame). It equals
 /// R(P/|P|) x; throws grbd::InvalidArgument for P = 0.
@@ -28,14 +28,14 @@ Vector3 sandwich(const Quaternion& P, const Vector3& x);
 /// For unit P this is the rigid body motion ξ = R ρ + r.
 Vector3 body_motion(const Quaternion& P, const Vector3& r, const Vector3& rho);
 
-//! [from rotation matrix declaration]
+// [from rotation matrix declaration]
 /// \brief <b>Exercise 1.4</b>: the quaternion of a rotation matrix (Shepperd's method).
 ///
 /// The unit quaternion p with R(p) = R and p0 ≥ 0, for a proper rotation
 /// matrix R (3 × 3). Robust at every angle, 0 and π included (Shepperd's method: divide by the
 /// largest of 4p0², 4p1², 4p2², 4p3², which are read off the diagonal of R).
 Quaternion quaternion_from_rotation_matrix(const Matrix3& R);
-//! [from rotation matrix declaration]
+// [from rotation matrix declaration]
 
 /// A rotation by `angle` (radians) about the unit vector `axis`.
 struct AxisAngle {

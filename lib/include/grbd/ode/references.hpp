@@ -36,14 +36,14 @@ struct EulerTop {
 /// moments that are not strictly increasing.
 EulerTop euler_top(const Vector3& K_Theta, const Vector3& K_omega0);
 
-//! [euler top omega declaration]
+// [euler top omega declaration]
 /// \brief <b>Exercise 3.4</b>: the elliptic solution of Euler's equations.
 ///
 /// The body angular velocity ω(t) = (s1 A1 cn τ, s2 A2 sn τ, s3 A3 dn τ), τ = λ(t − t0), with
 /// the Jacobi elliptic functions of parameter m (Boost.Math: boost::math::jacobi_elliptic, which
 /// takes the modulus k = √m).
 Vector3 euler_top_omega(const EulerTop& top, double t);
-//! [euler top omega declaration]
+// [euler top omega declaration]
 
 /// The half-period of the intermediate-axis (Dzhanibekov) flip: ω2 changes sign every 2K(m)/λ.
 /// Throws grbd::InvalidArgument unless λ > 0 and m ∈ [0, 1).

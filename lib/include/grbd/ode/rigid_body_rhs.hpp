@@ -18,14 +18,14 @@ Eigen::VectorXd pack(const body::State& x);
 /// The inverse of pack(); y must have 13 entries.
 body::State unpack(const Eigen::Ref<const Eigen::VectorXd>& y);
 
-//! [free body rhs declaration]
+// [free body rhs declaration]
 /// \brief <b>Exercise 3.1</b>: the right-hand side of a rigid body under constant loads.
 ///
 /// For y = (q, u) ∈ ℝ¹³: ẏ = (F(q) u, M⁻¹ h(u)), the kinematic map of chapter 1 and the
 /// Newton–Euler equations of chapter 2. Writes the 13 entries of y_dot.
 void free_body_rhs(const body::RigidBody& body, const body::Loads& loads,
                    const Eigen::Ref<const Eigen::VectorXd>& y, Eigen::Ref<Eigen::VectorXd> y_dot);
-//! [free body rhs declaration]
+// [free body rhs declaration]
 
 /// free_body_rhs() as a RhsFunction for Cvode and Arkode (the loads are constant in time).
 /// Throws grbd::InvalidArgument for a body without positive, finite m and K_Theta, and, when
@@ -54,14 +54,14 @@ struct HeavyTop {
 /// y or y_dot without 7 entries.
 RhsFunction heavy_top(const HeavyTop& top);
 
-//! [quaternion projection declaration]
+// [quaternion projection declaration]
 /// \brief <b>Exercise 3.2</b>: the projection onto |p| = 1.
 ///
 /// For the solution y whose entries offset … offset+3 hold a quaternion p, writes the correction
 /// that CVODE adds to y: p/|p| − p in those four entries, zero in all others.
 void quaternion_projection(Eigen::Index offset, const Eigen::Ref<const Eigen::VectorXd>& y,
                            Eigen::Ref<Eigen::VectorXd> correction);
-//! [quaternion projection declaration]
+// [quaternion projection declaration]
 
 /// quaternion_projection() as a ProjectionFunction for Cvode::set_projection(). Throws
 /// grbd::InvalidArgument for offset < 0, and, when called, for a quaternion that does not fit

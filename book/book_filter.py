@@ -1,0 +1,144 @@
+#!/usr/bin/env python3
+"""Doxygen input filter for the chapters (FILTER_PATTERNS in book/Doxyfile.in).
+
+Doxygen runs `book_filter.py chapters/NN-topic/chapter.md` and reads the page from stdout. The
+filter adds what a book needs and plain Doxygen markdown cannot express, without changing the line
+numbers of the source (so Doxygen's warnings still point at the right line):
+
+- Exercise headings `### Exercise N.M {#label}` get their title from the exercise's marker in
+  solutions/ (`// BEGIN EXERCISE N.M: title`), the single source of every exercise title.
+- Figures `\\image html NAME.svg "caption"` are numbered per chapter ("Figure N.k: caption") and
+  get the anchor `fig_NAME`; `\\figref{NAME}` in the text becomes a link "Figure N.k".
+- Every chapter gets previous/next links, at the top (in place of the blank line after the title)
+  and at the bottom, following the order of the chapter folders; the last chapter leads to the
+  bibliography.
+
+Problems (an exercise without a marker in solutions/, a heading that carries its own title, a
+reference to an unknown figure) are written into the page as visible text starting with
+"BOOK ERROR", which the book check (tests/book/check_book.py) refuses, and to stderr.
+"""
+
+from __future__ import annotations
+
+import pathlib
+import re
+import sys
+
+ROOT = pathlib.Path(__file__).resolve().parent.parent
+sys.path.insert(0, str(ROOT / "scripts"))
+import grbd_exercises as gx  # noqa: E402
+
+TITLE = re.compile(r"^#\s+(?P<title>Chapter\s+(?P<number>\d+):.*?)\s*\{#(?P<label>\w+)\}\s*$")
+EXERCISE = re.compile(r"^(?P<hashes>#{2,4})\s+Exercise\s+(?P<id>\d+\.\d+)(?P<rest>[^{]*?)\s*"
+                      r"(?P<anchor>\{#\w+\})\s*$")
+IMAGE = re.compile(r'^(?P<indent>\s*)\\image\s+html\s+(?P<file>(?P<name>[\w.-]+)\.svg)\s+'
+                   r'"(?P<caption>[^"]*)"(?P<rest>.*)$')
+FIGREF = re.compile(r"\\figref\{(?P<name>[\w.-]+)\}")
+
+
+def chapter_pages() -> list[tuple[str, str]]:
+    """(label, title) of every chapter, in the order of the chapter folders."""
+    pages = []
+    for path in sorted(ROOT.glob("chapters/[0-9][0-9]-*/chapter.md")):
+        first = path.read_text(encoding="utf-8").splitlines()[0]
+        m = TITLE.match(first)
+        if m:
+            pages.append((m.group("label"), m.group("title")))
+    return pages
+
+
+def exercise_titles() -> dict[str, str]:
+    """'N.M' -> title, from the markers in solutions/."""
+    titles: dict[str, str] = {}
+    for chapter_dir in gx.chapter_dirs(ROOT):
+        for ex in gx.exercises_of(chapter_dir, ROOT):
+            titles[ex.id] = ex.title
+    return titles
+
+
+def navigation(label: str, pages: list[tuple[str, str]], where: str) -> str:
+    """One line of previous / contents / next links for the chapter `label`."""
+    labels = [p[0] for p in pages]
+    i = labels.index(label)
+    prev = f'\\ref {pages[i - 1][0]} "← {pages[i - 1][1]}"' if i > 0 else \
+        '\\ref index "← The book"'
+    nxt = f'\\ref {pages[i + 1][0]} "{pages[i + 1][1]} →"' if i + 1 < len(pages) else \
+        '\\ref bibliography "Bibliography →"'
+    return (f'<div class="grbd-nav grbd-nav-{where}">{prev} | \\ref index "Contents" | '
+            f"{nxt}</div>")
+
+
+def book_error(message: str, path: pathlib.Path, line: int) -> str:
+    print(f"{path}:{line}: book_filter: {message}", file=sys.stderr)
+    return f"BOOK ERROR: {message}"
+
+
+def filter_chapter(path: pathlib.Path, text: str) -> str:
+    lines = text.split("\n")
+    m = TITLE.match(lines[0]) if lines else None
+    if not m:
+        return text  # not a chapter page: leave it alone
+    number, label = int(m.group("number")), m.group("label")
+    pages = chapter_pages()
+    titles = exercise_titles()
+
+    # Number the figures first, so that \figref may point forward.
+    figures: dict[str, str] = {}
+    for line in lines:
+        image = IMAGE.match(line)
+        if image:
+            figures.setdefault(image.group("name"), f"Figure {number}.{len(figures) + 1}")
+
+    out = []
+    for i, line in enumerate(lines):
+        heading = EXERCISE.match(line)
+        image = IMAGE.match(line)
+        if heading:
+            ex_id, rest = heading.group("id"), heading.group("rest").strip()
+            if rest:
+                line = book_error(f"the heading of Exercise {ex_id} carries its own title "
+                                  f"'{rest}'; write '{heading.group('hashes')} Exercise {ex_id} "
+                                  f"{heading.group('anchor')}' and keep the title in the "
+                                  "solution's BEGIN EXERCISE marker", path, i + 1)
+            elif ex_id not in titles:
+                line = book_error(f"Exercise {ex_id} has no '// BEGIN EXERCISE {ex_id}: title' "
+                                  "marker in solutions/", path, i + 1)
+            else:
+                line = (f"{heading.group('hashes')} Exercise {ex_id}: {titles[ex_id]} "
+                        f"{heading.group('anchor')}")
+        elif image:
+            name = image.group("name")
+            line = (f'{image.group("indent")}\\anchor fig_{name.replace("-", "_")} '
+                    f'\\image html {image.group("file")} '
+                    f'"{figures[name]}: {image.group("caption")}"{image.group("rest")}')
+
+        def figref(ref: re.Match) -> str:
+            name = ref.group("name")
+            if name not in figures:
+                return book_error(f"\\figref{{{name}}}: no figure {name}.svg in this chapter",
+                                  path, i + 1)
+            return f'\\ref fig_{name.replace("-", "_")} "{figures[name]}"'
+
+        line = FIGREF.sub(figref, line)
+        if i == 1 and not line.strip() and label in [p[0] for p in pages]:
+            line = navigation(label, pages, "top")
+        out.append(line)
+    if label in [p[0] for p in pages]:
+        while out and not out[-1].strip():
+            out.pop()
+        out += ["", navigation(label, pages, "bottom"), ""]
+    return "\n".join(out)
+
+
+def main() -> int:
+    if len(sys.argv) != 2:
+        print("usage: book_filter.py <page.md>  (a Doxygen INPUT_FILTER)", file=sys.stderr)
+        return 2
+    path = pathlib.Path(sys.argv[1])
+    text = path.read_text(encoding="utf-8")
+    sys.stdout.write(filter_chapter(path, text))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
