@@ -7,7 +7,7 @@ The book must render its mathematics offline and keep doing so when its folder i
 server or a USB stick, so it holds real files, never links to the system's MathJax: the TeX input,
 the HTML-CSS output with the TeX web fonts (woff, and otf for old browsers), the MathML element
 jax, and the extensions the configuration loads or MathJax loads on demand. Debian's
-libjs-mathjax links the fonts to fonts-mathjax; they are copied as files. About 1.5 MB in all,
+libjs-mathjax links the fonts to fonts-mathjax; they are copied as files. About 2.3 MB in all,
 against 54 MB for the whole of MathJax. A second run copies only what changed.
 """
 
