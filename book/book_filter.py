@@ -28,7 +28,6 @@ ROOT = pathlib.Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT / "scripts"))
 import grbd_exercises as gx  # noqa: E402
 
-TITLE = re.compile(r"^#\s+(?P<title>Chapter\s+(?P<number>\d+):.*?)\s*\{#(?P<label>\w+)\}\s*$")
 EXERCISE = re.compile(r"^(?P<hashes>#{2,4})\s+Exercise\s+(?P<id>\d+\.\d+)(?P<rest>[^{]*?)\s*"
                       r"(?P<anchor>\{#\w+\})\s*$")
 IMAGE = re.compile(r'^(?P<indent>\s*)\\image\s+html\s+(?P<file>(?P<name>[\w.-]+)\.svg)\s+'
@@ -36,12 +35,21 @@ IMAGE = re.compile(r'^(?P<indent>\s*)\\image\s+html\s+(?P<file>(?P<name>[\w.-]+)
 FIGREF = re.compile(r"\\figref\{(?P<name>[\w.-]+)\}")
 
 
+def chapter_heading(text: str) -> re.Match | None:
+    """The first line of a chapter page, '# Chapter N: Title {#label}', or None."""
+    m = gx.CHAPTER_TITLE.match(text.split("\n", 1)[0])
+    return m if m and m.group("label") else None
+
+
+def figure_anchor(name: str) -> str:
+    return "fig_" + name.replace("-", "_")
+
+
 def chapter_pages() -> list[tuple[str, str]]:
     """(label, title) of every chapter, in the order of the chapter folders."""
     pages = []
     for path in sorted(ROOT.glob("chapters/[0-9][0-9]-*/chapter.md")):
-        first = path.read_text(encoding="utf-8").splitlines()[0]
-        m = TITLE.match(first)
+        m = chapter_heading(path.read_text(encoding="utf-8"))
         if m:
             pages.append((m.group("label"), m.group("title")))
     return pages
@@ -56,10 +64,8 @@ def exercise_titles() -> dict[str, str]:
     return titles
 
 
-def navigation(label: str, pages: list[tuple[str, str]], where: str) -> str:
-    """One line of previous / contents / next links for the chapter `label`."""
-    labels = [p[0] for p in pages]
-    i = labels.index(label)
+def navigation(i: int, pages: list[tuple[str, str]], where: str) -> str:
+    """One line of previous / contents / next links for the chapter pages[i]."""
     prev = f'\\ref {pages[i - 1][0]} "← {pages[i - 1][1]}"' if i > 0 else \
         '\\ref index "← The book"'
     nxt = f'\\ref {pages[i + 1][0]} "{pages[i + 1][1]} →"' if i + 1 < len(pages) else \
@@ -74,12 +80,14 @@ def book_error(message: str, path: pathlib.Path, line: int) -> str:
 
 
 def filter_chapter(path: pathlib.Path, text: str) -> str:
-    lines = text.split("\n")
-    m = TITLE.match(lines[0]) if lines else None
+    m = chapter_heading(text)
     if not m:
         return text  # not a chapter page: leave it alone
+    lines = text.split("\n")
     number, label = int(m.group("number")), m.group("label")
     pages = chapter_pages()
+    labels = [page_label for page_label, _ in pages]
+    position = labels.index(label) if label in labels else None
     titles = exercise_titles()
 
     # Number the figures first, so that \figref may point forward.
@@ -108,7 +116,7 @@ def filter_chapter(path: pathlib.Path, text: str) -> str:
                         f"{heading.group('anchor')}")
         elif image:
             name = image.group("name")
-            line = (f'{image.group("indent")}\\anchor fig_{name.replace("-", "_")} '
+            line = (f'{image.group("indent")}\\anchor {figure_anchor(name)} '
                     f'\\image html {image.group("file")} '
                     f'"{figures[name]}: {image.group("caption")}"{image.group("rest")}')
 
@@ -117,16 +125,16 @@ def filter_chapter(path: pathlib.Path, text: str) -> str:
             if name not in figures:
                 return book_error(f"\\figref{{{name}}}: no figure {name}.svg in this chapter",
                                   path, i + 1)
-            return f'\\ref fig_{name.replace("-", "_")} "{figures[name]}"'
+            return f'\\ref {figure_anchor(name)} "{figures[name]}"'
 
         line = FIGREF.sub(figref, line)
-        if i == 1 and not line.strip() and label in [p[0] for p in pages]:
-            line = navigation(label, pages, "top")
+        if i == 1 and not line.strip() and position is not None:
+            line = navigation(position, pages, "top")
         out.append(line)
-    if label in [p[0] for p in pages]:
+    if position is not None:
         while out and not out[-1].strip():
             out.pop()
-        out += ["", navigation(label, pages, "bottom"), ""]
+        out += ["", navigation(position, pages, "bottom"), ""]
     return "\n".join(out)
 
 

@@ -50,18 +50,11 @@ class WorstCase {
   /// and every error passed to update().
   explicit WorstCase(double initial) : worst_(initial) {}
 
-  /// Records `error`; if it is a new worst (or the first NaN), stores `describe()`, a callable
-  /// returning something convertible to std::string, as the description of the input. Returns
-  /// whether it was a new worst.
-  template <class Describe>
-  bool update(double error, Describe&& describe) {
-    if (!is_new_worst(error)) return false;
-    record(error, -1, std::string(std::forward<Describe>(describe)()));
-    return true;
-  }
-
-  /// As update(error, describe), for the input of sample number `sample` of the loop: the message
-  /// then reads "... at sample <sample>: <description>" (a negative `sample` stands for none).
+  /// Records `error` for the input of sample number `sample` of the loop (a negative `sample`
+  /// stands for none); if it is a new worst (or the first NaN), stores `describe()`, a callable
+  /// returning something convertible to std::string, as the description of the input. The
+  /// message then reads "... at sample <sample>: <description>". Returns whether it was a new
+  /// worst.
   template <class Describe>
   bool update(double error, long long sample, Describe&& describe) {
     if (!is_new_worst(error)) return false;
@@ -69,14 +62,14 @@ class WorstCase {
     return true;
   }
 
+  /// As update(error, sample, describe), for an input that is not a numbered sample.
+  template <class Describe>
+  bool update(double error, Describe&& describe) {
+    return update(error, -1, std::forward<Describe>(describe));
+  }
+
   /// The worst error: the largest one seen (at least the initial value), NaN if any was NaN.
   double value() const { return nan_ ? std::numeric_limits<double>::quiet_NaN() : worst_; }
-  /// Whether a NaN error was seen.
-  bool saw_nan() const { return nan_; }
-  /// Whether some update() recorded an input (false while no error exceeded the initial value).
-  bool has_input() const { return has_input_; }
-  /// The sample number of the worst input, −1 if it was not given or there is none.
-  long long sample() const { return sample_; }
   /// The description of the worst input (empty if there is none).
   const std::string& input() const { return input_; }
 
@@ -176,33 +169,28 @@ void put_scalar(std::ostream& os, const T& x) {
 template <class T>
 void put_value(std::ostream& os, const T& x);
 
+/// The items 0 … n − 1 of a list, each written by put_item(k), as [a, b, c].
+template <class PutItem>
+void put_list(std::ostream& os, Eigen::Index n, PutItem&& put_item) {
+  os << "[";
+  for (Eigen::Index k = 0; k < n; ++k) {
+    if (k > 0) os << ", ";
+    put_item(k);
+  }
+  os << "]";
+}
+
 /// A vector as [a, b, c]; a matrix as its rows, [[a, b], [c, d]].
 template <class Derived>
 void put_eigen(std::ostream& os, const Eigen::DenseBase<Derived>& x) {
   const auto& A = x.derived().eval();
-  const auto put_row = [&](Eigen::Index i) {
-    os << "[";
-    for (Eigen::Index j = 0; j < A.cols(); ++j) {
-      if (j > 0) os << ", ";
-      put_scalar(os, A(i, j));
-    }
-    os << "]";
-  };
   if (A.cols() == 1 || A.rows() == 1) {
-    os << "[";
-    for (Eigen::Index k = 0; k < A.size(); ++k) {
-      if (k > 0) os << ", ";
-      put_scalar(os, A(k));
-    }
-    os << "]";
+    put_list(os, A.size(), [&](Eigen::Index k) { put_scalar(os, A(k)); });
     return;
   }
-  os << "[";
-  for (Eigen::Index i = 0; i < A.rows(); ++i) {
-    if (i > 0) os << ", ";
-    put_row(i);
-  }
-  os << "]";
+  put_list(os, A.rows(), [&](Eigen::Index i) {
+    put_list(os, A.cols(), [&](Eigen::Index j) { put_scalar(os, A(i, j)); });
+  });
 }
 
 /// Dispatch: strings as they are; Eigen vectors and matrices; quaternions as (p0, p1, p2, p3);
