@@ -8,11 +8,14 @@
 
 #include <algorithm>
 #include <cmath>
+#include <string>
+#include <limits>
 
 #include "grbd/contact/problem.hpp"
 #include "grbd/contact/prox.hpp"
 #include "grbd/contact/solver.hpp"
 #include "grbd/core/error.hpp"
+#include "grbd/core/norms.hpp"
 
 namespace grbd::contact {
 
@@ -32,6 +35,7 @@ Vector2 prox_disk(const Vector2& x, double radius) {
   // EXERCISE 5.2: the prox onto the disk of radius ρ
   // Hint: compare ‖x‖² with ρ² first: no square root (and no division) when x is inside.
   // Hint: count ‖x‖ = ρ as inside, or x = 0 in the disk of radius 0 becomes 0/0.
+  // Hint: ‖x‖² overflows for |x| ≳ 10¹⁵⁴ (and ρ² for ρ ≳ 10¹⁵⁴) although ‖x‖ does not: outside
   throw grbd::NotImplemented("Exercise 5.2", "the prox onto the disk of radius ρ",
                              "Chapter 5: Prox contact laws and solvers",
                              "exercises/05-contact-laws/prox.cpp");
@@ -43,6 +47,7 @@ Vector3 prox_cone(const Vector3& x, double mu) {
   // EXERCISE 5.3: the prox onto the Coulomb cone
   // Hint: three cases: x in K_μ; x in the polar cone {μ‖x_T‖ ≤ −x_N}; otherwise the surface.
   // Hint: for μ = 0, ‖x_T‖ ≤ μx_N alone accepts (−1, 0, 0); only the surface divides by ‖x_T‖.
+  // Hint: take ‖x_T‖ from grbd::norm2d: x_T² overflows for |x_T| ≳ 10¹⁵⁴.
   throw grbd::NotImplemented("Exercise 5.3", "the prox onto the Coulomb cone",
                              "Chapter 5: Prox contact laws and solvers",
                              "exercises/05-contact-laws/prox.cpp");
@@ -62,7 +67,7 @@ Vector3 alart_curnier_update(const Vector3& lambda, const Vector3& xi, double r_
 // [de saxce]
 Vector3 de_saxce_update(const Vector3& lambda, const Vector3& xi, double r, double mu) {
   Vector3 augmented = xi;
-  augmented(0) += mu * std::sqrt(xi(1) * xi(1) + xi(2) * xi(2));
+  augmented(0) += mu * norm2d(xi(1), xi(2));
   return prox_cone(lambda - r * augmented, mu);
 }
 // [de saxce]
@@ -82,7 +87,23 @@ double natural_map_residual(std::span<const Vector3> lambda, std::span<const Vec
   for (std::size_t i = 0; i < lambda.size(); ++i) {
     sum += natural_map(lambda[i], xi[i], mu[i]).squaredNorm();
   }
-  return std::sqrt(sum);
+  if (sum >= std::numeric_limits<double>::min() && sum <= std::numeric_limits<double>::max()) {
+    return std::sqrt(sum);
+  }
+  // The sum of squares overflowed or underflowed (or an entry is not finite): a second pass
+  // scaled by the largest component, as euclidean_norm() does.
+  double largest = 0.0;
+  for (std::size_t i = 0; i < lambda.size(); ++i) {
+    const Vector3 F = natural_map(lambda[i], xi[i], mu[i]);
+    if (F.hasNaN()) return std::numeric_limits<double>::quiet_NaN();
+    largest = std::max(largest, F.cwiseAbs().maxCoeff());
+  }
+  if (largest == 0.0 || std::isinf(largest)) return largest;
+  double scaled = 0.0;
+  for (std::size_t i = 0; i < lambda.size(); ++i) {
+    scaled += (natural_map(lambda[i], xi[i], mu[i]) / largest).squaredNorm();
+  }
+  return largest * std::sqrt(scaled);
 }
 
 // [impact velocity]
@@ -116,6 +137,13 @@ Vector3 sor_contact_update(const ContactConstraint& c, const RFactors& r, ProxFo
 [[gnu::flatten]] void sor_sweep(const ContactProblem& problem, std::span<const RFactors> r,
                                 ProxForm form, std::span<Vector6> u, std::span<Vector3> lambda) {
   const std::size_t n = problem.contacts.size();
+  if (r.size() != n || lambda.size() != n || u.size() != problem.M_inv.size()) {
+    throw InvalidArgument("sor_sweep: expected " + std::to_string(n) + " r-factors and " +
+                          std::to_string(n) + " percussions (one per contact) and " +
+                          std::to_string(problem.M_inv.size()) + " velocities (one per body); "
+                          "found " + std::to_string(r.size()) + ", " +
+                          std::to_string(lambda.size()) + " and " + std::to_string(u.size()));
+  }
   const ContactConstraint* contacts = problem.contacts.data();
   const std::span<const InverseMass> M_inv(problem.M_inv);
   // Software prefetch for piles that do not fit in the caches: the contact kAhead places ahead

@@ -15,6 +15,7 @@ namespace grbd::contact {
 
 // [delassus block]
 Matrix3 delassus_block(const ContactConstraint& contact, std::span<const InverseMass> M_inv) {
+  require_body_indices(contact, M_inv.size(), "delassus_block");
   // BEGIN EXERCISE 5.5: the Delassus block of one contact
   // Hint: build W_aᵀM_a⁻¹W_a column by column: InverseMass::apply to each column of W_a.
   // Hint: both sides add: the minus sign of W_b appears twice.
@@ -56,6 +57,10 @@ RFactors r_factors(const Matrix3& G, double alpha) {
 // [converged]
 bool has_converged(std::span<const double> x_old, std::span<const double> x, double abs_tol,
                    double rel_tol) {
+  if (x_old.size() != x.size()) {
+    throw InvalidArgument("has_converged: expected x_old and x of the same length; found " +
+                          std::to_string(x_old.size()) + " and " + std::to_string(x.size()));
+  }
   // BEGIN EXERCISE 5.8: the convergence test of an iteration
   // Hint: a NaN must never count as converged: write the test so that it fails for NaN.
   // Hint: the relative part scales with |x[k]| of the new iterate, and equality counts.

@@ -903,3 +903,55 @@ TEST(ImplicitGyroscopic, NeverGainsEnergyOnAFastSpinningRodWhereTheExplicitSchem
 TEST(ImplicitGyroscopic, ConvergesAtFirstOrderOnTheSymmetricTop) {
   expect_order(grbd::body::implicit_gyroscopic_step, 0.85, 1.15);
 }
+
+// Regression (issue 11): the integrators accepted zero and NaN orientations and NaN loads and
+// carried the NaN on; kinetic_energy accepted a negative mass. Reference: the declarations in
+// rigid_body.hpp (a State has |p| = 1 within kUnitQuaternionTolerance; loads are finite; m > 0).
+TEST(IntegratorInput, RefusesNonUnitQuaternionsNonFiniteStatesAndLoads) {
+  const RigidBody body{2.0, Vector3(1.0, 2.0, 3.0)};
+  const State good{make_q(Vector3(1.0, 2.0, 3.0), Quaternion{}), Vector6::Constant(0.5)};
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  struct Bad {
+    const char* what;
+    State x;
+    Loads loads;
+    const char* named;
+  };
+  std::vector<Bad> cases;
+  State zero = good;
+  zero.q.tail<4>().setZero();
+  cases.push_back({"zero quaternion", zero, {}, "|p| = 0"});
+  State twice = good;
+  twice.q.tail<4>() *= 2.0;
+  cases.push_back({"|p| = 2", twice, {}, "|p| = 2"});
+  State nan_p = good;
+  nan_p.q(4) = nan;
+  cases.push_back({"NaN quaternion", nan_p, {}, "quaternion"});
+  State nan_r = good;
+  nan_r.q(1) = nan;
+  cases.push_back({"NaN position", nan_r, {}, "position"});
+  State nan_u = good;
+  nan_u.u(5) = nan;
+  cases.push_back({"NaN velocity", nan_u, {}, "velocity"});
+  Loads nan_force;
+  nan_force.I_F(2) = nan;
+  cases.push_back({"NaN force", good, nan_force, "loads"});
+  Loads inf_torque;
+  inf_torque.K_M(0) = std::numeric_limits<double>::infinity();
+  cases.push_back({"infinite torque", good, inf_torque, "loads"});
+  for (const grbd::body::IntegratorInfo& info : grbd::body::integrators()) {
+    for (const Bad& bad : cases) {
+      SCOPED_TRACE(std::string(info.name) + ": " + bad.what);
+      std::string message;
+      try {
+        grbd::body::step(body, bad.x, bad.loads, 0.01, info.scheme);
+      } catch (const grbd::InvalidArgument& error) {
+        message = error.what();
+      }
+      EXPECT_NE(message.find(bad.named), std::string::npos) << "message: '" << message << "'";
+    }
+    EXPECT_NO_THROW(grbd::body::step(body, good, {}, 0.01, info.scheme));
+  }
+  EXPECT_THROW(grbd::body::kinetic_energy(RigidBody{-1.0, Vector3::Ones()}, Vector6::Ones()),
+               grbd::InvalidArgument);
+}

@@ -10,9 +10,11 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <functional>
 #include <limits>
 #include <numeric>
 #include <set>
+#include <string>
 #include <vector>
 
 #include "grbd/collision/broad_phase.hpp"
@@ -371,6 +373,50 @@ TEST(CellGrid, RefusesInvalidInput) {
   EXPECT_THROW(brute_force_pairs(bad, radii, 0.0), grbd::InvalidArgument);
   EXPECT_THROW(brute_force_pairs(centres, radii, -1.0), grbd::InvalidArgument);
   EXPECT_THROW(brute_force_pairs(centres, std::vector<double>{1.0}, 0.0), grbd::InvalidArgument);
+}
+
+}  // namespace
+
+namespace {
+
+// Regression (issue 11): finite centres at ±1e308 made the extent of the grid infinite; the cell
+// size became ∞, (x − origin)/h NaN, and its conversion to int undefined (then std::length_error).
+// Reference: a grid over the centres exists only when their differences are finite; both the
+// grid and the Morton order refuse the set with grbd::InvalidArgument naming the axis.
+TEST(CellGrid, RefusesCentresWhoseExtentOverflows) {
+  const std::vector<Vector3> centres{{-1e308, 0, 0}, {1e308, 0, 0}, {0, 0, 0}};
+  const std::vector<double> radii{0.5, 0.5, 0.5};
+  CellGrid grid;
+  for (const auto& call : {std::function<void()>([&] { grid.build(centres, radii, 0.0); }),
+                           std::function<void()>([&] { morton_order(centres, 1.0); })}) {
+    try {
+      call();
+      ADD_FAILURE() << "centres at ±1e308 were accepted";
+    } catch (const grbd::InvalidArgument& error) {
+      EXPECT_NE(std::string(error.what()).find("axis 0"), std::string::npos) << error.what();
+      EXPECT_NE(std::string(error.what()).find("largest double"), std::string::npos)
+          << error.what();
+    }
+  }
+}
+
+// The largest finite extent still works (no overflow in the cell coordinates): two touching
+// spheres at x ≈ 1.7e308 and one at the origin, compared with brute force.
+TEST(CellGrid, LargestFiniteExtentMatchesBruteForce) {
+  const double far = 1.7e308;
+  const std::vector<Vector3> centres{{0, 0, 0}, {far, 0, 0}, {far, 0.5, 0}, {far, 0, -1e300}};
+  const std::vector<double> radii{1.0, 1.0, 1.0, 1.0};
+  CellGrid grid;
+  grid.build(centres, radii, 0.0);
+  std::vector<IndexPair> pairs;
+  grid.find_pairs(pairs);
+  std::sort(pairs.begin(), pairs.end());
+  std::vector<IndexPair> reference = brute_force_pairs(centres, radii, 0.0);
+  std::sort(reference.begin(), reference.end());
+  EXPECT_EQ(pairs, reference);
+  EXPECT_EQ(reference.size(), 1U);
+  const std::vector<std::int32_t> order = morton_order(centres, 1.0);
+  EXPECT_EQ(std::set<std::int32_t>(order.begin(), order.end()).size(), centres.size());
 }
 
 }  // namespace

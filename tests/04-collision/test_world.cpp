@@ -259,3 +259,54 @@ TEST(CollisionWorld, DetectsBoxOnGroundAndSphereAgainstBox) {
   EXPECT_EQ(sphere_box->body_a, 0);
   EXPECT_EQ(sphere_box->body_b, 1);
 }
+
+// Regression (issue 11): detect used the quaternion of a state as given. A sphere 0.5 above the
+// ground with p = (2, 0, 0, 0) got a contact (its lever arms scale by |p|²), and zero or NaN
+// orientations went through. Reference: body::State requires |p| = 1 (rigid_body.hpp); the
+// refusal names the body and |p|.
+TEST(CollisionWorld, RefusesStatesWithoutAUnitQuaternionNamingTheBody) {
+  CollisionWorld world;
+  world.add({HalfSpace{Vector3::UnitZ(), 0.0}});
+  world.add({Sphere{0.5}, 0});
+  world.add({Sphere{0.5}, 1});
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const State good = at(Vector3(3.0, 0.0, 1.0));
+  struct Bad {
+    const char* what;
+    grbd::Vector4 p;
+    const char* named;
+  };
+  const std::vector<Bad> cases{{"|p| = 2", {2.0, 0.0, 0.0, 0.0}, "|p| = 2"},
+                               {"zero", {0.0, 0.0, 0.0, 0.0}, "|p| = 0"},
+                               {"NaN", {nan, 0.0, 0.0, 0.0}, "nan"},
+                               {"|p| = 1 + 1e-5", {1.0 + 1e-5, 0.0, 0.0, 0.0}, "unit"}};
+  for (const Bad& bad : cases) {
+    SCOPED_TRACE(bad.what);
+    State spoilt = at(Vector3(0.0, 0.0, 0.5));
+    spoilt.q.tail<4>() = bad.p;
+    std::vector<Contact> contacts;
+    std::string message;
+    try {
+      world.detect(std::vector<State>{good, spoilt}, 0.1, contacts);
+    } catch (const grbd::InvalidArgument& error) {
+      message = error.what();
+    }
+    EXPECT_NE(message.find("body 1"), std::string::npos) << "message: '" << message << "'";
+    EXPECT_NE(message.find(bad.named), std::string::npos) << "message: '" << message << "'";
+  }
+  // Within the documented tolerance 1e-6 (round-off of the exponential map is 1e-15 per step).
+  State nearly = at(Vector3(0.0, 0.0, 0.5));
+  nearly.q.tail<4>() *= 1.0 + 1e-9;
+  std::vector<Contact> contacts;
+  EXPECT_NO_THROW(world.detect(std::vector<State>{good, nearly}, 0.1, contacts));
+  EXPECT_EQ(contacts.size(), 1U);
+  // A non-finite position or velocity is named too.
+  State moving = at(Vector3(0.0, 0.0, 0.5));
+  moving.u[4] = nan;
+  try {
+    world.detect(std::vector<State>{moving, good}, 0.1, contacts);
+    ADD_FAILURE() << "a NaN velocity was accepted";
+  } catch (const grbd::InvalidArgument& error) {
+    EXPECT_NE(std::string(error.what()).find("body 0"), std::string::npos) << error.what();
+  }
+}

@@ -20,6 +20,7 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <initializer_list>
 #include <limits>
 #include <numbers>
@@ -1256,4 +1257,98 @@ TEST(AssembleProblem, RefusesInconsistentInput) {
   EXPECT_THROW(
       assemble_problem(std::vector<grbd::collision::Contact>{k}, bodies, states, u_free, {}),
       grbd::InvalidArgument);
+}
+
+namespace {
+
+// One contact between body 0 and body 1 of two bodies, with unit force directions.
+ContactProblem two_body_problem() {
+  ContactProblem p;
+  p.M_inv.assign(2, InverseMass{});
+  p.u_free.assign(2, Vector6::Zero());
+  ContactConstraint c;
+  c.body_a = 0;
+  c.body_b = 1;
+  c.W_a.topRows<3>() = Matrix3::Identity();
+  c.W_b.topRows<3>() = Matrix3::Identity();
+  p.contacts.push_back(c);
+  return p;
+}
+
+std::string refusal_of(const std::function<void()>& call) {
+  try {
+    call();
+  } catch (const grbd::InvalidArgument& error) {
+    return error.what();
+  }
+  return "";
+}
+
+}  // namespace
+
+// Regression (issue 11): these public functions indexed their arrays with the body indices and
+// lengths they were given (heap-buffer-overflow under ASan): a body index out of range, r or λ
+// shorter than the contacts, spans of different lengths. Reference: their declarations (one λ
+// and one r per contact, one u and one M⁻¹ per body); each refuses with InvalidArgument naming
+// what is wrong.
+TEST(ProblemInput, PublicFunctionsRefuseIndicesAndLengthsOutOfRange) {
+  ContactProblem p = two_body_problem();
+  p.contacts[0].body_b = 7;
+  const std::vector<Vector3> lambda(1, Vector3::Zero());
+  std::string m = refusal_of([&] { velocities_from_percussions(p, lambda); });
+  EXPECT_NE(m.find("body_b = 7"), std::string::npos) << m;
+  m = refusal_of([&] { contact_velocities(p, p.u_free); });
+  EXPECT_NE(m.find("body_b = 7"), std::string::npos) << m;
+  m = refusal_of([&] { delassus_block(p.contacts[0], p.M_inv); });
+  EXPECT_NE(m.find("body_b = 7"), std::string::npos) << m;
+  p.contacts[0].body_b = -5;
+  m = refusal_of([&] { delassus_block(p.contacts[0], p.M_inv); });
+  EXPECT_NE(m.find("body_b = -5"), std::string::npos) << m;
+
+  const ContactProblem good = two_body_problem();
+  std::vector<Vector6> u = good.u_free;
+  std::vector<Vector3> l(1, Vector3::Zero());
+  const std::vector<RFactors> r(1, RFactors{1.0, 1.0});
+  const std::vector<RFactors> no_r;
+  std::vector<Vector3> no_lambda;
+  m = refusal_of([&] { grbd::contact::sor_sweep(good, no_r, ProxForm::alart_curnier, u, l); });
+  EXPECT_NE(m.find("sor_sweep"), std::string::npos) << m;
+  m = refusal_of(
+      [&] { grbd::contact::sor_sweep(good, r, ProxForm::alart_curnier, u, no_lambda); });
+  EXPECT_NE(m.find("percussions"), std::string::npos) << m;
+  std::vector<Vector6> short_u(1, Vector6::Zero());
+  m = refusal_of([&] { grbd::contact::sor_sweep(good, r, ProxForm::alart_curnier, short_u, l); });
+  EXPECT_NE(m.find("velocities"), std::string::npos) << m;
+  EXPECT_NO_THROW(grbd::contact::sor_sweep(good, r, ProxForm::alart_curnier, u, l));
+
+  const std::vector<double> three(3, 0.0), two(2, 0.0);
+  m = refusal_of([&] { has_converged(three, two, 0.0, 0.0); });
+  EXPECT_NE(m.find("same length"), std::string::npos) << m;
+}
+
+// Regression (issue 11): assemble_problem used the orientations of `states` as given: p = 2 e₀
+// scales every lever arm in W by |p|² = 4. Reference: body::State requires |p| = 1; the refusal
+// names the body.
+TEST(AssembleProblem, RefusesStatesWithoutAUnitQuaternion) {
+  const std::vector<RigidBody> bodies{{1.0, Vector3::Ones()}, {1.0, Vector3::Ones()}};
+  std::vector<State> states(2, State{make_q(Vector3::Zero(), {}), Vector6::Zero()});
+  states[1].q.tail<4>() << 2.0, 0.0, 0.0, 0.0;
+  const std::vector<Vector6> u_free(2, Vector6::Zero());
+  grbd::collision::Contact k;
+  k.body_a = 0;
+  k.body_b = 1;
+  const std::vector<grbd::collision::Contact> contacts{k};
+  const std::string m = refusal_of([&] { assemble_problem(contacts, bodies, states, u_free, {}); });
+  EXPECT_NE(m.find("body 1"), std::string::npos) << m;
+  EXPECT_NE(m.find("|p| = 2"), std::string::npos) << m;
+}
+
+// Regression (issue 11): validate() let an infinite Delassus diagonal through (W ≈ 1e200 gives
+// G = WᵀM⁻¹W = ∞); the solvers then iterated on NaN. Reference: validate()'s declaration.
+TEST(ProblemInput, ValidateRefusesAnInfiniteDelassusDiagonal) {
+  ContactProblem p = two_body_problem();
+  p.contacts[0].W_a(0, 0) = 1e200;
+  const std::string m = refusal_of([&] { validate(p); });
+  EXPECT_NE(m.find("Delassus"), std::string::npos) << m;
+  EXPECT_NE(m.find("inf"), std::string::npos) << m;
 }

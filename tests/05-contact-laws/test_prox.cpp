@@ -684,3 +684,66 @@ TEST(NaturalMap, ResidualOfAProblem) {
   EXPECT_THROW(natural_map_residual(lambda, xi, short_mu), grbd::InvalidArgument);
   EXPECT_THROW(natural_map_residual(short_xi, xi, mu), grbd::InvalidArgument);
 }
+
+// Regression (issue 11): ‖x‖² overflows for |x| ≳ 1.3e154 and underflows for |x| ≲ 1e-162
+// although ‖x‖ does not; prox_disk then returned 0 for x = (3e200, 4e200) (ρ/√∞ = 0).
+// Reference: positive homogeneity, prox_D(ρ)(s x) = s prox_D(ρ/s)(x), and the closed form
+// ρ x/‖x‖ with ‖(3, 4)‖ = 5 exactly.
+TEST(Exercise5_2, HugeAndTinyVectorsNeitherOverflowNorUnderflow) {
+  for (const double s : {1e200, 1e-200, 1e300, 1e-300}) {
+    SCOPED_TRACE("scale " + std::to_string(s));
+    const Vector2 x(3.0 * s, -4.0 * s);
+    const Vector2 outside = prox_disk(x, 2.5 * s);
+    EXPECT_NEAR(outside(0), 1.5 * s, 4 * kEps * s);
+    EXPECT_NEAR(outside(1), -2.0 * s, 4 * kEps * s);
+    EXPECT_EQ(prox_disk(x, 6.0 * s), x);  // inside: unchanged
+    EXPECT_EQ(prox_disk(x, 5.0 * s), x);  // on the boundary: unchanged
+  }
+  const Vector2 unit = prox_disk(Vector2(3e200, 4e200), 1.0);
+  EXPECT_NEAR(unit(0), 0.6, 4 * kEps);
+  EXPECT_NEAR(unit(1), 0.8, 4 * kEps);
+}
+
+// Regression (issue 11): the cone's ‖x_T‖ overflowed in the same way (NaN from ∞/∞). Reference:
+// positive homogeneity, prox_K(s x) = s prox_K(x), against the unscaled projection.
+TEST(Exercise5_3, HugeAndTinyVectorsNeitherOverflowNorUnderflow) {
+  Random rng(5531);
+  WorstCase worst;
+  for (int n = 0; n < 200; ++n) {
+    const Vector3 x = rng.vector3(-2.0, 2.0);
+    const double mu = rng.uniform(0.0, 2.0);
+    const Vector3 y = prox_cone(x, mu);
+    for (const double s : {1e200, 1e-200, 1e300, 1e-300}) {
+      const Vector3 scaled = prox_cone(s * x, mu) / s;
+      worst.update((scaled - y).cwiseAbs().maxCoeff() / std::max(1.0, y.norm()), n,
+                   [&] { return describe("x", x, "mu", mu, "scale", s); });
+    }
+  }
+  EXPECT_LE(worst.value(), 1e-14) << worst;
+}
+
+// Regression (issue 11): the residual of a huge but finite problem summed squares to ∞. Reference:
+// the residual is positively homogeneous, ‖F(sλ, sξ)‖ = s ‖F(λ, ξ)‖.
+TEST(NaturalMap, ResidualOfHugeAndTinyProblemsIsFinite) {
+  Random rng(5504);
+  std::vector<Vector3> lambda, xi;
+  std::vector<double> mu;
+  for (int i = 0; i < 20; ++i) {
+    lambda.push_back(rng.vector3(-1.0, 2.0));
+    xi.push_back(rng.vector3());
+    mu.push_back(rng.uniform(0.0, 1.0));
+  }
+  const double reference = natural_map_residual(lambda, xi, mu);
+  for (const double s : {1e200, 1e-200, 1e300, 1e-300}) {
+    std::vector<Vector3> sl, sx;
+    for (std::size_t i = 0; i < lambda.size(); ++i) {
+      sl.push_back(s * lambda[i]);
+      sx.push_back(s * xi[i]);
+    }
+    EXPECT_NEAR(natural_map_residual(sl, sx, mu) / s, reference, 1e-13 * reference)
+        << "scale " << s;
+  }
+  const double inf = std::numeric_limits<double>::infinity();
+  lambda[3](1) = inf;
+  EXPECT_FALSE(std::isfinite(natural_map_residual(lambda, xi, mu)));
+}

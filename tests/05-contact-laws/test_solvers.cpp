@@ -33,8 +33,12 @@
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
+#include <cstdio>
+#include <cstdlib>
+#include <chrono>
 #include <cstdint>
 #include <functional>
+#include <future>
 #include <iterator>
 #include <limits>
 #include <numbers>
@@ -979,6 +983,9 @@ TEST(SolverInput, BodyFormRefusesBadProblemsOptionsAndGuesses) {
          p.contacts[0].body_b = grbd::contact::kStatic;
        },
        "Delassus"},
+      // Regression (issue 11): an infinite diagonal of G passed validate().
+      {"infinite Delassus diagonal", [](ContactProblem& p) { p.contacts[2].W_a(0, 0) = 1e200; },
+       "Delassus"},
   };
   struct BadOptions {
     const char* what;
@@ -999,6 +1006,12 @@ TEST(SolverInput, BodyFormRefusesBadProblemsOptionsAndGuesses) {
       {"max 0", [](SolverOptions& o) { o.max_iterations = 0; }, "max_iterations"},
       {"negative abs_tol", [](SolverOptions& o) { o.abs_tol = -1e-12; }, "abs_tol"},
       {"negative rel_tol", [](SolverOptions& o) { o.rel_tol = -1e-6; }, "rel_tol"},
+      // Regression (issue 11): enum values outside the enumerators were accepted.
+      {"criterion 7", [](SolverOptions& o) { o.criterion = static_cast<Criterion>(7); },
+       "criterion"},
+      {"r_strategy -1",
+       [](SolverOptions& o) { o.r_strategy = static_cast<RFactorStrategy>(-1); }, "r_strategy"},
+      {"form 2", [](SolverOptions& o) { o.form = static_cast<ProxForm>(2); }, "form"},
   };
   for (const Method& method : kMethods) {
     for (const BadProblem& bad : problems) {
@@ -1071,6 +1084,10 @@ TEST(SolverInput, LocalFormRefusesBadProblemsAndGuesses) {
       {"zero diagonal", [&](LocalProblem& p) { diagonal(p, 1)(1, 1) = 0.0; }, "diagonal"},
       {"negative diagonal", [&](LocalProblem& p) { diagonal(p, 0)(0, 0) = -1.0; }, "diagonal"},
       {"NaN W", [&](LocalProblem& p) { diagonal(p, 3)(2, 2) = nan; }, "W"},
+      // Regression (issue 11): an infinite diagonal passed, and APGD ran 1000 NaN iterations.
+      {"infinite diagonal",
+       [&](LocalProblem& p) { diagonal(p, 2)(0, 0) = std::numeric_limits<double>::infinity(); },
+       "W"},
   };
   for (const Method& method : kMethods) {
     for (const Bad& bad : problems) {
@@ -1114,5 +1131,98 @@ TEST(SolverInput, LocalFormRefusesBadProblemsAndGuesses) {
       });
       EXPECT_TRUE(contains(message, "alpha")) << "message: '" << message << "'";
     }
+  }
+}
+
+namespace {
+
+// One contact with W = w I (a 3 × 3 block), q and μ.
+LocalProblem one_contact(double w, const Vector3& q, double mu) {
+  LocalProblem p;
+  p.W.row_start = {0, 1};
+  p.W.column = {0};
+  p.W.blocks = {w * grbd::Matrix3::Identity()};
+  p.W.diagonal = {0};
+  p.q = {q};
+  p.mu = {mu};
+  return p;
+}
+
+}  // namespace
+
+// Regression (issue 11): one contact, W = 2I, q = (−1e200, 1e200, −1e200), μ = 0.5. The squared
+// norms in prox_disk and in the residual overflowed: λ_T came out 0 and the solvers reported
+// "converged" with a NaN residual. Reference: the closed form of a sliding contact with W = 2I:
+// ξ_N = 0 gives λ_N = −q_N/2, and λ_T = −μ λ_N q_T/‖q_T‖ (sliding, since ‖q_T‖/2 > μ λ_N);
+// the same problem scaled by 10⁻²⁰⁰ has the solution scaled alike.
+TEST(SolverRobustness, HugeButFiniteProblemMatchesTheSlidingClosedForm) {
+  const double mu = 0.5;
+  for (const double s : {1e200, 1.0, 1e-200}) {
+    const Vector3 q(-s, s, -s);
+    const LocalProblem problem = one_contact(2.0, q, mu);
+    const double lambda_N = s / 2.0;
+    const Vector2 q_T = q.tail<2>();
+    const Vector2 direction = q_T / std::hypot(q_T(0), q_T(1));
+    const Vector3 expected(lambda_N, -mu * lambda_N * direction(0),
+                           -mu * lambda_N * direction(1));
+    for (const Method& method : kMethods) {
+      SCOPED_TRACE(std::string(method.name) + ", scale " + std::to_string(s));
+      std::vector<Vector3> lambda;
+      const SolverResult result = solve(method, problem, lambda, natural(1e-12, 1000));
+      EXPECT_TRUE(result.converged) << grbd::contact::describe(result);
+      EXPECT_FALSE(result.diverged);
+      EXPECT_TRUE(std::isfinite(result.residual)) << grbd::contact::describe(result);
+      ASSERT_EQ(lambda.size(), 1U);
+      EXPECT_LE((lambda[0] - expected).cwiseAbs().maxCoeff(), 1e-10 * lambda_N)
+          << "lambda = " << lambda[0].transpose() << ", expected " << expected.transpose();
+    }
+  }
+}
+
+// Regression (issue 11): a non-finite iterate never met the criterion, so the solvers ran to
+// max_iterations, and with max_iterations = INT_MAX the loop counter overflowed and they never
+// stopped (ch05_fclib --max-iterations 2147483647). One contact with W = 1e-300 I (a valid,
+// positive diagonal) and q_N = −1e10: r_N = 1/W_NN = 1e300 makes λ_N = ∞ in the first iteration.
+// Reference: SolverResult's declaration: a non-finite iterate stops the solver at once, as
+// divergence, never as convergence. A watchdog turns a hang into a failure.
+TEST(SolverRobustness, NonFiniteIterateStopsAtOnceEvenWithIntMaxIterations) {
+  const LocalProblem problem = one_contact(1e-300, Vector3(-1e10, 0.0, 0.0), 0.3);
+  for (const Method& method : kMethods) {
+    for (const Criterion criterion : {Criterion::percussion_change, Criterion::velocity_change,
+                                      Criterion::natural_residual}) {
+      SCOPED_TRACE(std::string(method.name) + ", criterion " +
+                   std::to_string(static_cast<int>(criterion)));
+      SolverOptions options;
+      options.criterion = criterion;
+      options.max_iterations = std::numeric_limits<int>::max();
+      std::vector<Vector3> lambda;
+      auto run = std::async(std::launch::async,
+                            [&] { return solve(method, problem, lambda, options); });
+      if (run.wait_for(std::chrono::seconds(30)) != std::future_status::ready) {
+        std::fprintf(stderr, "FAILED: %s did not stop within 30 s on a diverging problem\n",
+                     method.name);
+        std::_Exit(1);  // the solver thread cannot be stopped; a hang must not stall the suite
+      }
+      const SolverResult result = run.get();
+      EXPECT_FALSE(result.converged) << grbd::contact::describe(result);
+      EXPECT_TRUE(result.diverged) << grbd::contact::describe(result);
+      EXPECT_LE(result.iterations, 100) << grbd::contact::describe(result);
+      EXPECT_NE(grbd::contact::describe(result).find("DIVERGED"), std::string::npos);
+    }
+  }
+}
+
+// max_iterations = INT_MAX is accepted and changes nothing on a problem that converges.
+TEST(SolverRobustness, IntMaxIterationsIsAcceptedAndStopsAtConvergence) {
+  Random rng(5820);
+  const LocalProblem problem =
+      grbd::test::to_local_form(grbd::test::random_problem(rng, spec_for(6, 0.0, false)));
+  for (const Method& method : kMethods) {
+    SCOPED_TRACE(method.name);
+    std::vector<Vector3> lambda;
+    const SolverResult result =
+        solve(method, problem, lambda, natural(1e-10, std::numeric_limits<int>::max()));
+    EXPECT_TRUE(result.converged) << grbd::contact::describe(result);
+    EXPECT_LT(result.iterations, 100000);
   }
 }

@@ -33,15 +33,19 @@ constexpr std::array<IntegratorInfo, 5> kIntegrators{{
      "|p| = 1; no energy gain if axisymmetric"},
 }};
 
-/// Throws InvalidArgument unless the step size h is positive and finite and the body is valid
-/// (require_valid() of rigid_body.hpp). Comparisons only: the hot path allocates nothing.
-void require_valid(const RigidBody& body, double h, const char* where) {
+/// Throws InvalidArgument unless the step size h is positive and finite and the body, the
+/// state (finite, unit quaternion) and the loads are valid (rigid_body.hpp). Comparisons and
+/// one 4-vector norm: the hot path allocates nothing.
+void require_valid(const RigidBody& body, const State& x, const Loads& loads, double h,
+                   const char* where) {
   if (!(h > 0.0) || !std::isfinite(h)) {
     throw InvalidArgument(
         std::string(where) +
         ": the step size h must be positive and finite, but h = " + format_number(h));
   }
   require_valid(body, where);
+  require_valid(x, where);
+  require_finite(loads, where);
 }
 
 /// The kick of duration t by constant loads: v ← v + t I_F/m, K_omega ← K_omega + t Θ⁻¹ K_M.
@@ -77,7 +81,7 @@ Integrator parse_integrator(std::string_view name) {
 
 // [symplectic exp map step]
 State symplectic_exp_map_step(const RigidBody& body, const State& x, const Loads& loads, double h) {
-  require_valid(body, h, "symplectic_exp_map_step");
+  require_valid(body, x, loads, h, "symplectic_exp_map_step");
   // The only change from (a): the velocities are updated first, and q moves with u⁺. For the
   // translation this is the symplectic Euler method; q⁺ is again an exact exp-map motion.
   const Vector6 u = x.u + h * newton_euler_u_dot(body, x.u, loads);
@@ -88,7 +92,7 @@ State symplectic_exp_map_step(const RigidBody& body, const State& x, const Loads
 // [explicit euler normalized step]
 State explicit_euler_normalized_step(const RigidBody& body, const State& x, const Loads& loads,
                                      double h) {
-  require_valid(body, h, "explicit_euler_normalized_step");
+  require_valid(body, x, loads, h, "explicit_euler_normalized_step");
   // A straight step in ℝ⁷ leaves S³ (|p|² grows by 1 + h²|ω|²/4, chapter 1); the projection back
   // onto S³ hides the drift but turns by 2 atan(h|ω|/2) instead of h|ω|.
   State next{kinematics::explicit_euler_step(x.q, x.u, h),
@@ -100,7 +104,7 @@ State explicit_euler_normalized_step(const RigidBody& body, const State& x, cons
 
 // [lie poisson step]
 State lie_poisson_step(const RigidBody& body, const State& x, const Loads& loads, double h) {
-  require_valid(body, h, "lie_poisson_step");
+  require_valid(body, x, loads, h, "lie_poisson_step");
   // Strang splitting of H = (kinetic energy of translation) + T₁ + T₂ + T₃ + (the loads): every
   // piece is solved exactly, and the palindromic order makes the composition symmetric, hence of
   // order 2. Each free rotation keeps |L| and I_L = A_IK Θ ω, so their composition does too.
@@ -120,7 +124,7 @@ State lie_poisson_step(const RigidBody& body, const State& x, const Loads& loads
 // [implicit gyroscopic step]
 State implicit_gyroscopic_step(const RigidBody& body, const State& x, const Loads& loads,
                                double h) {
-  require_valid(body, h, "implicit_gyroscopic_step");
+  require_valid(body, x, loads, h, "implicit_gyroscopic_step");
   // Backward Euler on Euler's equations, f(ω⁺) = Θ(ω⁺ − ω) + h ω⁺ × Θω⁺ − h K_M = 0, linearised
   // once at ω⁺ = ω (Catto 2015): the Jacobian of a × Θa is ãΘ − (Θa)~, so
   //   (Θ + h(ω̃Θ − (Θω)~)) Δω = −f(ω) = h (K_M − ω × Θω).
@@ -143,7 +147,7 @@ State step(const RigidBody& body, const State& x, const Loads& loads, double h, 
   switch (scheme) {
     case Integrator::explicit_exp_map:
       // The exercise checks nothing itself; the dispatch checks for it.
-      require_valid(body, h, "step(explicit_exp_map)");
+      require_valid(body, x, loads, h, "step(explicit_exp_map)");
       return explicit_exp_map_step(body, x, loads, h);
     case Integrator::symplectic_exp_map:
       return symplectic_exp_map_step(body, x, loads, h);

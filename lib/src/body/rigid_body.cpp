@@ -11,6 +11,7 @@
 
 #include "grbd/core/checks.hpp"
 #include "grbd/core/error.hpp"
+#include "grbd/core/norms.hpp"
 #include "grbd/kinematics/rigid_motion.hpp"
 #include "grbd/kinematics/rotation.hpp"
 
@@ -28,6 +29,42 @@ void require_valid(const RigidBody& body, std::string_view where) {
                             std::to_string(i) + "] must be positive and finite, but it is " +
                             format_number(body.K_Theta[i]));
     }
+  }
+}
+
+namespace {
+
+std::string numbers(const auto& v) {
+  std::string text = "(";
+  for (Eigen::Index k = 0; k < v.size(); ++k) {
+    text += (k == 0 ? "" : ", ") + format_number(v[k]);
+  }
+  return text + ")";
+}
+
+}  // namespace
+
+void require_valid(const State& x, std::string_view where, std::size_t index) {
+  const auto refuse = [&](const std::string& what) {
+    const bool single = index == static_cast<std::size_t>(-1);
+    throw InvalidArgument(std::string(where) + (single ? "" : ": body " + std::to_string(index)) +
+                          ": " + what);
+  };
+  if (!x.q.head<3>().allFinite()) refuse("the position is not finite: " + numbers(x.q.head<3>()));
+  if (!x.u.allFinite()) refuse("the velocity u is not finite: " + numbers(x.u));
+  const Vector4 p = x.q.tail<4>();
+  const double norm = euclidean_norm(std::span<const double>(p.data(), 4));
+  if (!(std::abs(norm - 1.0) <= kUnitQuaternionTolerance)) {
+    refuse("expected a unit orientation quaternion (| |p| - 1 | <= 1e-6), found p = " +
+           numbers(p) + " with |p| = " + format_number(norm) +
+           (std::isfinite(norm) && norm > 0.0 ? " (normalise it)" : ""));
+  }
+}
+
+void require_finite(const Loads& loads, std::string_view where) {
+  if (!loads.I_F.allFinite() || !loads.K_M.allFinite()) {
+    throw InvalidArgument(std::string(where) + ": expected finite loads, found the force I_F = " +
+                          numbers(loads.I_F) + " and the torque K_M = " + numbers(loads.K_M));
   }
 }
 
@@ -53,6 +90,7 @@ Matrix6 mass_matrix(const RigidBody& body) {
 }
 
 double kinetic_energy(const RigidBody& body, const Vector6& u) {
+  require_valid(body, "kinetic_energy");  // a negative mass would make T indefinite
   // ½ uᵀ M u with M diagonal, without forming M.
   const Vector3 K_omega = kinematics::angular_velocity(u);
   return 0.5 * body.m * kinematics::linear_velocity(u).squaredNorm() +

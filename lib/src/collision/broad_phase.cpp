@@ -70,10 +70,30 @@ Eigen::Vector3d cells_per_axis(const Vector3& extent, double h) {
   return (extent / h).array().floor() + 1.0;
 }
 
-/// Cell coordinate floor(t) of t = (x − origin)/h, clamped to [0, n − 1].
+/// Cell coordinate floor(t) of t = (x − origin)/h, clamped to [0, n − 1]. The clamp comes
+/// before the conversion: converting a double outside the range of int32 is undefined.
 inline std::int32_t cell_coordinate(double t, std::int32_t n) {
-  const auto c = static_cast<std::int32_t>(t);  // t ≥ 0 up to rounding: truncation is floor
-  return std::clamp(c, 0, n - 1);
+  if (!(t > 0.0)) return 0;  // also NaN, which the callers' checks exclude
+  if (t >= static_cast<double>(n - 1)) return n - 1;
+  return static_cast<std::int32_t>(t);  // 0 < t < n − 1: truncation is floor
+}
+
+/// The bounding box of the centres, refused (InvalidArgument) when its extent overflows: the
+/// centres are finite, but their differences, and with them any grid over them, are not
+/// representable (centres at ±10³⁰⁸).
+std::pair<Vector3, Vector3> grid_box(std::string_view where, std::span<const Vector3> centres) {
+  const auto [lo, hi] = bounding_box(centres);
+  const Vector3 extent = hi - lo;
+  for (int k = 0; k < 3; ++k) {
+    if (!std::isfinite(extent[k])) {
+      throw InvalidArgument(std::string(where) + ": the centres span more than the largest "
+                            "double along axis " + std::to_string(k) + ", from " +
+                            format_number(lo[k]) + " to " + format_number(hi[k]) +
+                            "; expected coordinates whose differences are finite (a grid over "
+                            "them cannot be represented)");
+    }
+  }
+  return {lo, hi};
 }
 
 }  // namespace
@@ -84,7 +104,7 @@ std::vector<std::int32_t> morton_order(std::span<const Vector3> centres, double 
   const auto n = static_cast<std::int32_t>(centres.size());
   std::vector<std::int32_t> order(centres.size());
   if (n == 0) return order;
-  const auto [lo, hi] = bounding_box(centres);
+  const auto [lo, hi] = grid_box("morton_order", centres);
   // Coarsen the cells where the box would need more than 2²¹ of them along an axis.
   const double h = std::max(cell_size, (hi - lo).maxCoeff() / double(kMaxCellsPerAxis - 1));
   const auto max_cell = static_cast<std::int32_t>(kMaxCellsPerAxis - 1);
@@ -119,7 +139,7 @@ void CellGrid::build(std::span<const Vector3> centres, std::span<const double> r
   // or in adjacent cells when h ≥ 2 r_max + margin; the relative 1e-6 absorbs the rounding of
   // (x − origin)/h, which is below 1e-9 cell edges for up to 2²¹ cells per axis.
   const double r_max = *std::max_element(radii.begin(), radii.end());
-  const auto [lo, hi] = bounding_box(centres);
+  const auto [lo, hi] = grid_box("CellGrid::build", centres);
   const Vector3 extent = hi - lo;
   double h = (2.0 * r_max + margin) * (1.0 + 1e-6);
   // O(N) memory: at most 2N + 64 cells (and 2³⁰) and 2²¹ per axis; a sparse box gets larger cells.

@@ -148,7 +148,11 @@ void CollisionWorld::detect(std::span<const body::State> states, double margin,
           " needs body " + std::to_string(collider.body) + ", found " +
           std::to_string(states.size()) + " body states");
     }
-    const Vector7& q = states[static_cast<std::size_t>(collider.body)].q;
+    const auto b = static_cast<std::size_t>(collider.body);
+    // Finite, with a unit quaternion: a quaternion of norm 2 would place the collider and scale
+    // the lever arms wrongly without any sign of it.
+    body::require_valid(states[b], "CollisionWorld::detect", b);
+    const Vector7& q = states[b].q;
     A_IK[i] = kinematics::rotation_matrix(kinematics::orientation(q));
     placements[i] = {kinematics::position(q) + A_IK[i] * collider.K_r_KC, A_IK[i] * collider.A_KC};
   }

@@ -16,21 +16,35 @@ namespace {
 
 std::string contact_name(std::size_t i) { return "contact " + std::to_string(i); }
 
+/// "<where>: contact i" or "<where>" for kNoIndex.
+std::string contact_context(std::string_view where, std::size_t i) {
+  return i == kNoIndex ? std::string(where) : std::string(where) + ": " + contact_name(i);
+}
+
 [[noreturn]] void refuse(const std::string& what) {
   throw InvalidArgument("contact problem: " + what);
 }
 
 bool all_finite(const auto& matrix) { return matrix.allFinite(); }
 
-void check_body_index(BodyIndex index, std::size_t bodies, std::size_t i, const char* side) {
-  if (index == kStatic) return;
-  if (index < 0 || static_cast<std::size_t>(index) >= bodies) {
-    refuse(contact_name(i) + ": body_" + side + " = " + std::to_string(index) +
-           " is neither kStatic (-1) nor a body index in [0, " + std::to_string(bodies) + ")");
+}  // namespace
+
+void require_body_indices(const ContactConstraint& contact, std::size_t bodies,
+                          std::string_view where, std::size_t index) {
+  const auto check = [&](BodyIndex body, const char* side) {
+    if (body != kStatic && (body < 0 || static_cast<std::size_t>(body) >= bodies)) {
+      throw InvalidArgument(contact_context(where, index) + ": body_" + side +
+                            " = " + std::to_string(body) +
+                            " is neither kStatic (-1) nor a body index in [0, " +
+                            std::to_string(bodies) + ")");
+    }
+  };
+  check(contact.body_a, "a");
+  check(contact.body_b, "b");
+  if (contact.body_a == kStatic && contact.body_b == kStatic) {
+    throw InvalidArgument(contact_context(where, index) + ": both sides are static");
   }
 }
-
-}  // namespace
 
 InverseMass inverse_mass(const body::RigidBody& body) {
   body::require_valid(body, "inverse_mass");
@@ -70,11 +84,7 @@ void validate(const ContactProblem& problem) {
   }
   for (std::size_t i = 0; i < problem.contacts.size(); ++i) {
     const ContactConstraint& c = problem.contacts[i];
-    check_body_index(c.body_a, bodies, i, "a");
-    check_body_index(c.body_b, bodies, i, "b");
-    if (c.body_a == kStatic && c.body_b == kStatic) {
-      refuse(contact_name(i) + ": both sides are static");
-    }
+    require_body_indices(c, bodies, "contact problem", i);
     if (c.body_a == c.body_b) {
       refuse(contact_name(i) + ": body " + std::to_string(c.body_a) + " touches itself");
     }
@@ -95,8 +105,9 @@ void validate(const ContactProblem& problem) {
     }
     const Matrix3 G = delassus_block(c, problem.M_inv);
     for (int k = 0; k < 3; ++k) {
-      if (!(G(k, k) > 0.0)) {
-        refuse(contact_name(i) + ": the Delassus block G_ii needs a positive diagonal, found G(" +
+      if (!(G(k, k) > 0.0) || !std::isfinite(G(k, k))) {
+        refuse(contact_name(i) + ": the Delassus block G_ii needs a positive, finite diagonal, "
+               "found G(" +
                std::to_string(k) + "," + std::to_string(k) + ") = " + format_number(G(k, k)) +
                " (are its force directions W zero?)");
       }
@@ -110,9 +121,14 @@ std::vector<Vector6> velocities_from_percussions(const ContactProblem& problem,
     refuse("expected one percussion per contact (" + std::to_string(problem.contacts.size()) +
            "), found " + std::to_string(lambda.size()));
   }
+  if (problem.u_free.size() != problem.M_inv.size()) {
+    refuse("M_inv has " + std::to_string(problem.M_inv.size()) + " bodies but u_free has " +
+           std::to_string(problem.u_free.size()));
+  }
   std::vector<Vector6> u = problem.u_free;
   for (std::size_t i = 0; i < lambda.size(); ++i) {
     const ContactConstraint& c = problem.contacts[i];
+    require_body_indices(c, u.size(), "velocities_from_percussions", i);
     if (c.body_a != kStatic) u[c.body_a] += problem.M_inv[c.body_a].apply(c.W_a * lambda[i]);
     if (c.body_b != kStatic) u[c.body_b] -= problem.M_inv[c.body_b].apply(c.W_b * lambda[i]);
   }
@@ -127,6 +143,7 @@ std::vector<Vector3> contact_velocities(const ContactProblem& problem, std::span
   std::vector<Vector3> xi(problem.contacts.size());
   for (std::size_t i = 0; i < xi.size(); ++i) {
     const ContactConstraint& c = problem.contacts[i];
+    require_body_indices(c, u.size(), "contact_velocities", i);
     Vector3 gamma = Vector3::Zero();
     if (c.body_a != kStatic) gamma += c.W_a.transpose() * u[c.body_a];
     if (c.body_b != kStatic) gamma -= c.W_b.transpose() * u[c.body_b];
@@ -146,6 +163,11 @@ ContactProblem assemble_problem(std::span<const collision::Contact> contacts,
         std::to_string(bodies.size()) + ", " + std::to_string(states.size()) + " and " +
         std::to_string(u_free.size()));
   }
+  // The states are checked here, once per body, and not again in the loop over the contacts:
+  // a non-unit quaternion would scale every lever arm in W by |p|².
+  for (std::size_t b = 0; b < states.size(); ++b) {
+    body::require_valid(states[b], "assemble_problem", b);
+  }
   ContactProblem problem;
   problem.M_inv.reserve(bodies.size());
   for (const body::RigidBody& b : bodies) problem.M_inv.push_back(inverse_mass(b));
@@ -157,8 +179,7 @@ ContactProblem assemble_problem(std::span<const collision::Contact> contacts,
     ContactConstraint c;
     c.body_a = k.body_a;
     c.body_b = k.body_b;
-    check_body_index(c.body_a, bodies.size(), i, "a");
-    check_body_index(c.body_b, bodies.size(), i, "b");
+    require_body_indices(c, bodies.size(), "assemble_problem", i);
     Vector3 gamma_A = Vector3::Zero();
     if (c.body_a != kStatic) {
       const body::State& s = states[c.body_a];

@@ -16,6 +16,7 @@
 #include "grbd/contact/prox.hpp"
 #include "grbd/core/checks.hpp"
 #include "grbd/core/error.hpp"
+#include "grbd/core/norms.hpp"
 
 namespace grbd::contact {
 
@@ -28,10 +29,14 @@ std::span<const double> flat(std::span<const Vector6> v) {
   return {v.empty() ? nullptr : v.data()->data(), 6 * v.size()};
 }
 
-double norm(std::span<const Vector3> v) {
-  double sum = 0.0;
-  for (const Vector3& x : v) sum += x.squaredNorm();
-  return std::sqrt(sum);
+/// ‖v‖₂ without spurious overflow: a problem with q ≈ 10²⁰⁰ has finite norms.
+double norm(std::span<const Vector3> v) { return euclidean_norm(flat(v)); }
+
+bool all_finite(std::span<const Vector3> v) {
+  for (const Vector3& x : v) {
+    if (!x.allFinite()) return false;
+  }
+  return true;
 }
 
 void validate_options(const SolverOptions& o, const char* solver) {
@@ -51,6 +56,35 @@ void validate_options(const SolverOptions& o, const char* solver) {
   if (!(o.alpha > 0.0 && o.alpha < 2.0)) {
     throw InvalidArgument(where + "expected the relaxation alpha in (0, 2); found " +
                           format_number(o.alpha));
+  }
+  // An enum holds any value of its underlying type: a cast or a corrupted options struct would
+  // otherwise fall through every switch.
+  const auto refuse_enum = [&](const char* name, int value, const char* expected) {
+    throw InvalidArgument(where + "expected " + name + " to be one of " + expected + "; found " +
+                          "the value " + std::to_string(value));
+  };
+  switch (o.criterion) {
+    case Criterion::percussion_change:
+    case Criterion::velocity_change:
+    case Criterion::natural_residual:
+      break;
+    default:
+      refuse_enum("criterion", static_cast<int>(o.criterion),
+                  "percussion_change, velocity_change, natural_residual");
+  }
+  switch (o.r_strategy) {
+    case RFactorStrategy::per_contact:
+    case RFactorStrategy::global:
+      break;
+    default:
+      refuse_enum("r_strategy", static_cast<int>(o.r_strategy), "per_contact, global");
+  }
+  switch (o.form) {
+    case ProxForm::alart_curnier:
+    case ProxForm::de_saxce:
+      break;
+    default:
+      refuse_enum("form", static_cast<int>(o.form), "alart_curnier, de_saxce");
   }
 }
 
@@ -93,6 +127,21 @@ class BodyModel {
   void velocities(std::span<const Vector3> lambda, std::vector<Vector3>& xi) const {
     xi = contact_velocities(problem_, velocities_from_percussions(problem_, lambda));
   }
+  /// y = G x = Wᵀ M⁻¹ W x, the linear part of ξ(Λ), without u_free or restitution.
+  void apply_G(std::span<const Vector3> x, std::vector<Vector3>& y) const {
+    std::vector<Vector6> v(problem_.M_inv.size(), Vector6::Zero());
+    for (std::size_t i = 0; i < size(); ++i) {
+      const ContactConstraint& c = problem_.contacts[i];
+      if (c.body_a != kStatic) v[c.body_a] += problem_.M_inv[c.body_a].apply(c.W_a * x[i]);
+      if (c.body_b != kStatic) v[c.body_b] -= problem_.M_inv[c.body_b].apply(c.W_b * x[i]);
+    }
+    y.assign(size(), Vector3::Zero());
+    for (std::size_t i = 0; i < size(); ++i) {
+      const ContactConstraint& c = problem_.contacts[i];
+      if (c.body_a != kStatic) y[i] += c.W_a.transpose() * v[c.body_a];
+      if (c.body_b != kStatic) y[i] -= c.W_b.transpose() * v[c.body_b];
+    }
+  }
   /// Makes u consistent with Λ.
   void synchronize() { u = velocities_from_percussions(problem_, lambda_); }
   /// After JOR or APGD changed all of Λ at once: u follows Λ only when the velocity criterion
@@ -130,6 +179,11 @@ class LocalModel {
     xi.resize(size());
     multiply(problem_.W, lambda, xi);
     for (std::size_t i = 0; i < xi.size(); ++i) xi[i] += problem_.q[i];
+  }
+  /// y = W x, the linear part of ξ(Λ).
+  void apply_G(std::span<const Vector3> x, std::vector<Vector3>& y) const {
+    y.resize(size());
+    multiply(problem_.W, x, y);
   }
   void synchronize() { seen_.assign(size(), Vector3::Zero()); }
   void sor_sweep(std::span<const RFactors> r, ProxForm form) {
@@ -196,9 +250,15 @@ class Monitor {
     }
   }
 
-  /// Call after iteration k (1-based) with the model up to date; true to stop.
+  /// Call after iteration k (1-based) with the model up to date; true to stop: the criterion
+  /// is met (from min_iterations on), or an iterate is not finite (divergence: stop at once,
+  /// whatever max_iterations says).
   bool after(int k) {
     result_.iterations = k;
+    if (!all_finite(lambda_)) {
+      result_.diverged = true;
+      return true;
+    }
     double residual = -1.0;
     if (options_.record_history || options_.criterion == Criterion::natural_residual) {
       residual = natural_residual();
@@ -213,8 +273,7 @@ class Monitor {
         break;
       case Criterion::velocity_change: {
         const auto v = model_.watched_velocity();
-        met = !velocity_old_.empty() &&
-              has_converged(velocity_old_, v, options_.abs_tol, options_.rel_tol);
+        met = has_converged(velocity_old_, v, options_.abs_tol, options_.rel_tol);
         break;
       }
       case Criterion::natural_residual:
@@ -234,15 +293,14 @@ class Monitor {
     return natural_map_residual(lambda_, xi_, mu_);
   }
 
-  /// Fills residual and norm_max for the returned Λ.
+  /// Fills residual and norm_max for the returned Λ. A non-finite Λ or residual is divergence,
+  /// never convergence.
   void finish() {
     result_.residual = natural_residual();
     result_.norm_max = std::max({result_.norm_c, norm(lambda_), norm(xi_)});
-    for (const Vector3& l : lambda_) {
-      if (!l.allFinite()) {
-        result_.converged = false;
-        break;
-      }
+    if (!all_finite(lambda_) || !std::isfinite(result_.residual)) {
+      result_.diverged = true;
+      result_.converged = false;
     }
   }
 
@@ -261,6 +319,10 @@ class Monitor {
 
 using Clock = std::chrono::steady_clock;
 
+/// APGD doubles L at most this many times in one iteration (a factor 2⁶⁰ ≈ 10¹⁸): enough for any
+/// underestimate of λ_max(G) by the power iteration, and a bound on the work of one iteration.
+constexpr int kMaxBacktracking = 60;
+
 double seconds_since(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
 }
@@ -273,10 +335,12 @@ SolverResult run_sor(Model& model, std::vector<Vector3>& lambda, const SolverOpt
   const std::vector<RFactors> r = model_r_factors(model, options.r_strategy, options.alpha);
   model.synchronize();
   Monitor<Model> monitor(model, options, lambda, result);
-  for (int k = 1; k <= options.max_iterations; ++k) {
+  // The test sits at the end of the body: with max_iterations = INT_MAX the loop must stop
+  // before ++k overflows.
+  for (int k = 1;; ++k) {
     monitor.before();
     model.sor_sweep(r, options.form);
-    if (monitor.after(k)) break;
+    if (monitor.after(k) || k == options.max_iterations) break;
   }
   monitor.finish();
   result.seconds = seconds_since(start);
@@ -292,14 +356,14 @@ SolverResult run_jor(Model& model, std::vector<Vector3>& lambda, const SolverOpt
   model.synchronize();
   Monitor<Model> monitor(model, options, lambda, result);
   std::vector<Vector3> xi;
-  for (int k = 1; k <= options.max_iterations; ++k) {
+  for (int k = 1;; ++k) {  // stops at max_iterations at the end of the body, as run_sor
     monitor.before();
     model.velocities(lambda, xi);
     for (std::size_t i = 0; i < lambda.size(); ++i) {
       lambda[i] = prox_update(options.form, lambda[i], xi[i], r[i], model.mu(i));
     }
     model.record(xi, options.criterion == Criterion::velocity_change);
-    if (monitor.after(k)) break;
+    if (monitor.after(k) || k == options.max_iterations) break;
   }
   model.done();
   monitor.finish();
@@ -307,19 +371,19 @@ SolverResult run_jor(Model& model, std::vector<Vector3>& lambda, const SolverOpt
   return result;
 }
 
-/// λ_max(G) by power iteration on G = ξ(Λ) − ξ(0), from a fixed start vector.
+/// λ_max(G) by power iteration from a fixed start vector, with the linear part G of ξ(Λ) applied
+/// directly (Model::apply_G), not as ξ(x) − ξ(0): that difference loses G x in the rounding
+/// of ξ(0) = c when ‖G x‖ ≪ ‖c‖ (a problem with c ≈ 10²⁰⁰, or with G ≈ 10⁻³⁰⁰).
 template <class Model>
 double largest_eigenvalue(const Model& model, int iterations) {
   const std::size_t n = model.size();
-  std::vector<Vector3> x(n, Vector3(1.0, 0.5, 0.25)), y, zero(n, Vector3::Zero()), c;
-  model.velocities(zero, c);
+  std::vector<Vector3> x(n, Vector3(1.0, 0.5, 0.25)), y;
   double estimate = 0.0;
   for (int k = 0; k < iterations; ++k) {
     const double scale = norm(x);
-    if (scale == 0.0) break;
+    if (!(scale > 0.0) || !std::isfinite(scale)) break;
     for (Vector3& v : x) v /= scale;
-    model.velocities(x, y);
-    for (std::size_t i = 0; i < n; ++i) y[i] -= c[i];
+    model.apply_G(x, y);
     estimate = norm(y);
     x.swap(y);
   }
@@ -348,11 +412,11 @@ SolverResult run_apgd(Model& model, std::vector<Vector3>& lambda, const SolverOp
   // The De Saxcé offset s_i = μ_i ‖ξ_T,i‖, frozen for a cycle of at most kCycle iterations.
   constexpr int kCycle = 25;
   std::vector<double> s(n);
-  for (std::size_t i = 0; i < n; ++i) s[i] = model.mu(i) * xi_prev[i].tail<2>().norm();
+  for (std::size_t i = 0; i < n; ++i) s[i] = model.mu(i) * norm2d(xi_prev[i](1), xi_prev[i](2));
   int last_update = 0;
   bool frictional = false;
   for (std::size_t i = 0; i < n; ++i) frictional = frictional || model.mu(i) > 0.0;
-  for (int k = 1; k <= options.max_iterations; ++k) {
+  for (int k = 1;; ++k) {  // stops at max_iterations at the end of the body, as run_sor
     monitor.before();
     for (int attempt = 0;; ++attempt) {
       // x = P_K(y − t (ξ(y) + μ ‖ξ_T(y)‖ e_N)): one De Saxcé prox step from the extrapolated
@@ -364,24 +428,42 @@ SolverResult run_apgd(Model& model, std::vector<Vector3>& lambda, const SolverOp
         lambda[i] = prox_cone(y[i] - t * g, model.mu(i));
       }
       model.velocities(lambda, xi_x);
-      // G (x − y) = ξ(x) − ξ(y): ξ is affine in Λ.
+      // G (x − y) = ξ(x) − ξ(y): ξ is affine in Λ. Both sides of the test are divided by
+      // d² = max |x − y|², so that neither overflows nor underflows for percussions of 10²⁰⁰
+      // or 10⁻²⁰⁰ (a NaN from ∞ − ∞ would fail the test and drive L up for good).
+      double d = 0.0;
+      for (std::size_t i = 0; i < n; ++i) d = std::max(d, (lambda[i] - y[i]).cwiseAbs().maxCoeff());
+      // No step; or a step to ∞ or NaN, which the monitor reports as divergence: backtracking
+      // would only hide an iterate that overflows, as the solution of the problem does.
+      if (!(d > 0.0) || !std::isfinite(d)) break;
       double curvature = 0.0;
       double step2 = 0.0;
       for (std::size_t i = 0; i < n; ++i) {
-        const Vector3 dx = lambda[i] - y[i];
-        curvature += dx.dot(xi_x[i] - xi_y[i]);
+        const Vector3 dx = (lambda[i] - y[i]) / d;
+        curvature += dx.dot((xi_x[i] - xi_y[i]) / d);
         step2 += dx.squaredNorm();
       }
-      if (curvature <= L * step2 * (1.0 + 1e-12) || attempt == 60) break;
+      if (curvature <= L * step2 * (1.0 + 1e-12) || attempt == kMaxBacktracking) break;
       L *= 2.0;
     }
     // Adaptive restart (O'Donoghue and Candès 2015): drop the momentum when the step goes against
     // the direction of descent, g(y)ᵀ(x − x_prev) > 0.
-    double against = 0.0;
+    // Only the sign counts: both factors are scaled by their largest component.
+    double g_max = 0.0;
+    double step_max = 0.0;
     for (std::size_t i = 0; i < n; ++i) {
       Vector3 g = xi_y[i];
       g(0) += s[i];
-      against += g.dot(lambda[i] - x_prev[i]);
+      g_max = std::max(g_max, g.cwiseAbs().maxCoeff());
+      step_max = std::max(step_max, (lambda[i] - x_prev[i]).cwiseAbs().maxCoeff());
+    }
+    double against = 0.0;
+    if (g_max > 0.0 && step_max > 0.0) {
+      for (std::size_t i = 0; i < n; ++i) {
+        Vector3 g = xi_y[i];
+        g(0) += s[i];
+        against += (g / g_max).dot((lambda[i] - x_prev[i]) / step_max);
+      }
     }
     double beta = 0.0;
     if (against > 0.0 || (frictional && k - last_update >= kCycle)) {
@@ -389,7 +471,7 @@ SolverResult run_apgd(Model& model, std::vector<Vector3>& lambda, const SolverOp
       // the convex problem with a fixed s (Anitescu's relaxation shifted by s), whose fixed point
       // over the cycles is Coulomb's law.
       theta = 1.0;
-      for (std::size_t i = 0; i < n; ++i) s[i] = model.mu(i) * xi_x[i].tail<2>().norm();
+      for (std::size_t i = 0; i < n; ++i) s[i] = model.mu(i) * norm2d(xi_x[i](1), xi_x[i](2));
       last_update = k;
     } else {
       const double theta_next = 0.5 * (-theta * theta + theta * std::sqrt(theta * theta + 4.0));
@@ -405,7 +487,7 @@ SolverResult run_apgd(Model& model, std::vector<Vector3>& lambda, const SolverOp
     xi_prev = xi_x;
     L *= 0.9;
     model.record(xi_x, options.criterion == Criterion::velocity_change);
-    if (monitor.after(k)) break;
+    if (monitor.after(k) || k == options.max_iterations) break;
   }
   model.done();
   monitor.finish();
@@ -455,7 +537,10 @@ std::string describe(const SolverResult& result) {
   std::snprintf(line, sizeof line,
                 "%s %s after %d iterations: residual %.3e, relative to |q| %.3e, to max(|q|, "
                 "|r|, |u|) %.3e, %.3f ms",
-                result.solver.c_str(), result.converged ? "converged" : "did NOT converge",
+                result.solver.c_str(),
+                result.converged  ? "converged"
+                : result.diverged ? "DIVERGED (an iterate is not finite)"
+                                  : "did NOT converge",
                 result.iterations, result.residual, result.relative_residual(),
                 result.scaled_residual(), 1e3 * result.seconds);
   return line;

@@ -3,6 +3,7 @@
 /// \brief A rigid body in its principal frame: mass matrix, kinetic energy, angular momentum,
 /// the Jacobian of a material point, and the Newton–Euler equations M u̇ = h (chapter 2).
 
+#include <cstddef>
 #include <string_view>
 
 #include "grbd/body/mass_properties.hpp"
@@ -28,11 +29,27 @@ struct State {
   Vector6 u;  ///< 6 × 1: velocity of S in I [m/s], angular velocity in K [rad/s]
 };
 
+/// How far |p| of a State's orientation may be from 1: 10⁻⁶. The exponential map keeps |p| = 1 to
+/// round-off (10⁻¹⁵ per step), so only a quaternion that was never normalised (rounded input,
+/// a typo, a zero) fails; it would scale every lever arm A_IK ρ by |p|².
+inline constexpr double kUnitQuaternionTolerance = 1e-6;
+
+/// Throws InvalidArgument unless the state is finite and its orientation p is a unit quaternion
+/// (| |p| − 1 | ≤ kUnitQuaternionTolerance). The message reads "<where>: body <index>: …"
+/// ("<where>: …" for the default index, a single body) and shows the offending numbers. The
+/// functions that take states (the integrators, collision detection, the assembly of the
+/// contact problem) call it once per body and call.
+void require_valid(const State& x, std::string_view where,
+                   std::size_t index = static_cast<std::size_t>(-1));
+
 /// External loads, constant over a time step: a force through S and a torque about S.
 struct Loads {
   Vector3 I_F = Vector3::Zero();  ///< resultant force, frame I [N] (gravity: m I_g)
   Vector3 K_M = Vector3::Zero();  ///< resultant torque about S, frame K [N m]
 };
+
+/// Throws InvalidArgument, starting with `where`, unless the force and the torque are finite.
+void require_finite(const Loads& loads, std::string_view where);
 
 /// A rigid body made from a mesh: its principal-frame data, and where the frame K sits in the
 /// mesh frame M (a mesh point M_x has body coordinates K_x = A_MKᵀ (M_x − M_r_S)).

@@ -13,6 +13,7 @@
 
 #include <cstdint>
 #include <span>
+#include <string_view>
 #include <vector>
 
 #include "grbd/body/rigid_body.hpp"
@@ -25,6 +26,8 @@ namespace grbd::contact {
 using BodyIndex = collision::BodyIndex;
 /// The fixed world: its velocity is zero and its mass infinite.
 inline constexpr BodyIndex kStatic = collision::kStatic;
+/// "No contact index" for the messages of require_body_indices().
+inline constexpr std::size_t kNoIndex = static_cast<std::size_t>(-1);
 
 /// The inverse of a body's mass matrix in u = (I_v_S, K_omega), with K a principal frame (as
 /// body::RigidBody): M⁻¹ = diag(1/m, 1/m, 1/m, 1/Θ₁, 1/Θ₂, 1/Θ₃), constant in time because the
@@ -66,6 +69,14 @@ struct ContactProblem {
   std::vector<ContactConstraint> contacts;      ///< one per contact
   std::vector<collision::ContactKey> keys;      ///< empty, or one per contact
 };
+
+/// Throws InvalidArgument, starting with "<where>: contact <index>" (without the contact when
+/// `index` is kNoIndex), unless each side of
+/// `contact` is kStatic or a body index in [0, bodies), and the two sides are not both static.
+/// O(1), and nothing is allocated unless it throws: the checked entry points call it before they
+/// index by body.
+void require_body_indices(const ContactConstraint& contact, std::size_t bodies,
+                          std::string_view where, std::size_t index = kNoIndex);
 
 /// Checks a problem before a solver touches it and throws InvalidArgument naming the first bad
 /// entry (its kind and index), what was expected and what was found: body counts that disagree,
@@ -113,16 +124,23 @@ enum class ProxForm {
 /// change Δλ = λ⁺ − λ at once: u_a += M_a⁻¹ W_a Δλ, u_b −= M_b⁻¹ W_b Δλ (static sides are
 /// skipped). `lambda` is replaced by λ⁺. `M_inv` and `u` are indexed by body. Returns ξ, the
 /// velocity the update saw (before the change).
+///
+/// An unchecked kernel, the innermost step of SOR: the body indices of `c` must be valid for
+/// `M_inv` and `u`. It is reached through sor_sweep() and the solvers, which work on problems
+/// that validate() accepted.
 Vector3 sor_contact_update(const ContactConstraint& c, const RFactors& r, ProxForm form,
                            std::span<const InverseMass> M_inv, std::span<Vector6> u,
                            Vector3& lambda);
 // [sor contact update declaration]
 
-/// The end velocities u = u_free + M⁻¹ W Λ for percussions Λ (one λ per contact).
+/// The end velocities u = u_free + M⁻¹ W Λ for percussions Λ (one λ per contact). Throws
+/// InvalidArgument for a wrong number of percussions or body velocities, or a body index out of
+/// range.
 std::vector<Vector6> velocities_from_percussions(const ContactProblem& problem,
                                                  std::span<const Vector3> lambda);
 
 /// The impact-law velocities ξ_i = W_iᵀ u + ε_i ∘ γ_A,i of all contacts for body velocities u.
+/// Throws InvalidArgument for a wrong number of velocities or a body index out of range.
 std::vector<Vector3> contact_velocities(const ContactProblem& problem, std::span<const Vector6> u);
 
 /// Material data of a contact pair for assemble_problem().

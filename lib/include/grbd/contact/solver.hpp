@@ -50,7 +50,10 @@ enum class Criterion {
   natural_residual,   ///< ‖F‖ ≤ abs_tol + rel_tol ‖c‖ with F the natural map, c = free ξ
 };
 
-/// Options of every solver. Defaults suit a time step of a granular simulation.
+/// Options of every solver. Defaults suit a time step of a granular simulation. The solvers
+/// refuse (InvalidArgument) iteration counts outside 0 ≤ min_iterations ≤ max_iterations,
+/// max_iterations ≥ 1 (INT_MAX is allowed), tolerances that are negative or not finite, α ∉ (0, 2)
+/// and enum values outside their enumerators.
 struct SolverOptions {
   int min_iterations = 1;           ///< iterations always done
   int max_iterations = 1000;        ///< iterations at most; stopping there is non-convergence
@@ -68,6 +71,9 @@ struct SolverOptions {
 struct SolverResult {
   std::string solver;            ///< "SOR", "JOR" or "APGD"
   bool converged = false;        ///< the criterion was met within max_iterations
+  /// an iterate or the residual was not finite (∞ or NaN): the solver stopped at once; never
+  /// together with `converged`
+  bool diverged = false;
   int iterations = 0;            ///< iterations done
   double residual = 0.0;         ///< natural-map residual ‖F‖ of the returned λ
   double norm_c = 0.0;           ///< ‖c‖, the free contact velocities (FCLIB: ‖q‖)
@@ -99,7 +105,9 @@ std::vector<RFactors> r_factors(const ContactProblem& problem, RFactorStrategy s
 // [sor sweep declaration]
 /// One Gauss–Seidel sweep: sor_contact_update() for contacts 0, 1, …, n − 1 in order, each
 /// seeing the velocities its predecessors left. The hot loop of SOR, exposed for benchmarks and
-/// for the parallel solver of chapter 8.
+/// for the parallel solver of chapter 8. Throws InvalidArgument unless r and lambda have one entry
+/// per contact and u one per body (O(1)); the body indices of the contacts are not re-checked
+/// in every sweep: `problem` must be one that validate() accepted.
 void sor_sweep(const ContactProblem& problem, std::span<const RFactors> r, ProxForm form,
                std::span<Vector6> u, std::span<Vector3> lambda);
 // [sor sweep declaration]
