@@ -48,6 +48,10 @@ if(GRBD_BUILD_TESTS)
   find_package(GTest QUIET)
   grbd_require(GTest_FOUND "GoogleTest" libgtest-dev)
 endif()
+# CLI11 (header only): the command lines of the programs (ch05_fclib; the grbd tool of Chapter 7).
+find_package(CLI11 2.1 QUIET CONFIG)
+grbd_require(CLI11_FOUND "CLI11 >= 2.1 (command lines)" libcli11-dev)
+
 find_package(benchmark QUIET)
 grbd_require(benchmark_FOUND "Google Benchmark" libbenchmark-dev)
 

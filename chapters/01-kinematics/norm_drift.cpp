@@ -27,7 +27,6 @@
 #include <cstdio>
 #include <exception>
 #include <filesystem>
-#include <fstream>
 #include <iostream>
 #include <numbers>
 #include <sstream>
@@ -87,12 +86,10 @@ Result integrate(double h, double t_end, const Vector3& K_omega, const Vector3& 
   const double euler_lag_per_step = h * omega - 2.0 * std::atan(0.5 * h * omega);
   const double growth_per_step = 1.0 + 0.25 * h * h * omega * omega;
 
-  std::ofstream out(file);
-  if (!out) {
-    throw grbd::Error("ch01_norm_drift: cannot open '" + file.string() + "' for writing");
-  }
-  out << "t_s,n,euler_norm,euler_norm_predicted,expmap_norm_minus_one,euler_angle_error_rad,"
-         "euler_angle_error_predicted_rad,expmap_angle_error_rad\n";
+  grbd::demo::OutputFile out(file,
+                             "t_s,n,euler_norm,euler_norm_predicted,expmap_norm_minus_one,"
+                             "euler_angle_error_rad,euler_angle_error_predicted_rad,"
+                             "expmap_angle_error_rad");
   out.precision(17);
 
   Result result{h, 1.0, 1.0, 0.0, 0.0};
@@ -126,9 +123,7 @@ Result integrate(double h, double t_end, const Vector3& K_omega, const Vector3& 
         std::max(result.expmap_max_norm_deviation, std::abs(expmap_norm_minus_one));
     result.expmap_max_angle_error = std::max(result.expmap_max_angle_error, expmap_angle_error);
   }
-  if (!out) {
-    throw grbd::Error("ch01_norm_drift: writing '" + file.string() + "' failed");
-  }
+  out.finish();
   return result;
 }
 

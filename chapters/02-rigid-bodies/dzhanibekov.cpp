@@ -29,7 +29,6 @@
 #include <cstdio>
 #include <exception>
 #include <filesystem>
-#include <fstream>
 #include <iostream>
 #include <numbers>
 #include <string>
@@ -73,12 +72,12 @@ Reference reference(const Vector3& Theta, const Vector3& omega) {
   const double twoE = omega.dot(L);
   const double L2 = L.squaredNorm();
   if (!(I1 < I2 && I2 < I3)) {
-    throw grbd::Error("ch02_dzhanibekov: the principal moments must be distinct");
+    throw grbd::Error("the principal moments must be distinct");
   }
   if (!(L2 > twoE * I2)) {
     throw grbd::Error(
-        "ch02_dzhanibekov: the initial angular velocity is not on the branch "
-        "L^2 > 2E Theta2 that the reference formula covers");
+        "the initial angular velocity is not on the branch L^2 > 2E Theta2 that the reference "
+        "formula covers");
   }
   Reference r{};
   r.lambda = std::sqrt((I3 - I2) * (L2 - twoE * I1) / (I1 * I2 * I3));
@@ -94,8 +93,9 @@ Reference reference(const Vector3& Theta, const Vector3& omega) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  if (const auto exit_code = grbd::demo::check_arguments(argc, argv, "ch02_dzhanibekov", {"<data directory>"},
-                                   "writes omega.csv and flips.csv into the existing directory")) {
+  if (const auto exit_code = grbd::demo::check_arguments(
+          argc, argv, "ch02_dzhanibekov", {"<data directory>"},
+          "writes omega.csv and flips.csv into the existing directory")) {
     return *exit_code;
   }
   const std::filesystem::path data_dir = argv[1];
@@ -117,12 +117,7 @@ int main(int argc, char** argv) {
     const double T0 = body::kinetic_energy(rb, x.u);
     const double L0 = rb.K_Theta.cwiseProduct(K_omega0).norm();
 
-    const std::filesystem::path omega_file = data_dir / "omega.csv";
-    std::ofstream out(omega_file);
-    if (!out) {
-      throw grbd::Error("ch02_dzhanibekov: cannot open '" + omega_file.string() + "' for writing");
-    }
-    out << "t_s,omega1,omega2,omega3\n";
+    grbd::demo::OutputFile out(data_dir / "omega.csv", "t_s,omega1,omega2,omega3");
     out.precision(10);
     out << 0.0 << ',' << K_omega0(0) << ',' << K_omega0(1) << ',' << K_omega0(2) << '\n';
 
@@ -145,20 +140,13 @@ int main(int argc, char** argv) {
         out << n * kStep << ',' << w(0) << ',' << w(1) << ',' << w(2) << '\n';
       }
     }
-    if (!out) {
-      throw grbd::Error("ch02_dzhanibekov: writing '" + omega_file.string() + "' failed");
-    }
+    out.finish();
     if (zeros.size() < 2) {
-      throw grbd::Error("ch02_dzhanibekov: omega2 changed sign fewer than twice in " +
-                        std::to_string(kEndTime) + " s; no flip interval to measure");
+      throw grbd::Error("omega2 changed sign fewer than twice in " + std::to_string(kEndTime) +
+                        " s; no flip interval to measure");
     }
 
-    const std::filesystem::path flips_file = data_dir / "flips.csv";
-    std::ofstream flips(flips_file);
-    if (!flips) {
-      throw grbd::Error("ch02_dzhanibekov: cannot open '" + flips_file.string() + "' for writing");
-    }
-    flips << "j,t_predicted_s,t_measured_s\n";
+    grbd::demo::OutputFile flips(data_dir / "flips.csv", "j,t_predicted_s,t_measured_s");
     flips.precision(10);
     double max_flip_time_error = 0.0;
     for (std::size_t j = 0; j < zeros.size(); ++j) {
@@ -166,9 +154,7 @@ int main(int argc, char** argv) {
       flips << j + 1 << ',' << predicted << ',' << zeros[j] << '\n';
       max_flip_time_error = std::max(max_flip_time_error, std::abs(zeros[j] - predicted));
     }
-    if (!flips) {
-      throw grbd::Error("ch02_dzhanibekov: writing '" + flips_file.string() + "' failed");
-    }
+    flips.finish();
     const double measured_half_period =
         (zeros.back() - zeros.front()) / static_cast<double>(zeros.size() - 1);
 

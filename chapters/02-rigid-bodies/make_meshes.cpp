@@ -26,6 +26,7 @@
 #include <iostream>
 #include <numbers>
 #include <string>
+#include <system_error>
 #include <vector>
 
 #include "grbd/body/mass_properties.hpp"
@@ -121,11 +122,13 @@ int main(int argc, char** argv) {
   }
   const std::filesystem::path out_dir = argv[1];
   try {
-    std::error_code ec;
-    std::filesystem::create_directories(out_dir, ec);
-    if (!std::filesystem::is_directory(out_dir)) {
-      std::cerr << "ch02_make_meshes: cannot create the output directory '" << out_dir.string()
-                << "'" << (ec ? ": " + ec.message() : std::string()) << '\n';
+    std::error_code error;
+    std::filesystem::create_directories(out_dir, error);
+    if (const auto reason = grbd::demo::not_a_directory(out_dir)) {
+      std::cerr << "ch02_make_meshes: "
+                << grbd::demo::directory_message("output directory", out_dir,
+                                                 error ? error.message() : *reason)
+                << '\n';
       return 2;
     }
     const std::vector<NamedMesh> meshes = chapter_meshes();

@@ -32,7 +32,6 @@
 #include <cstdio>
 #include <exception>
 #include <filesystem>
-#include <fstream>
 #include <iostream>
 #include <numbers>
 #include <string>
@@ -76,11 +75,8 @@ Summary integrate(const body::RigidBody& rb, const body::State& x0, body::Integr
   const Vector3 I_L0 = body::I_angular_momentum(rb, x0);
   const int steps = static_cast<int>(std::lround(kEndTime / kStep));
 
-  std::ofstream out(file);
-  if (!out) {
-    throw grbd::Error("ch02_space_donut: cannot open '" + file.string() + "' for writing");
-  }
-  out << "t_s,energy_rel_error,momentum_rel_error,p_norm_error,energy_signed_rel_error\n";
+  grbd::demo::OutputFile out(
+      file, "t_s,energy_rel_error,momentum_rel_error,p_norm_error,energy_signed_rel_error");
   out.precision(10);
   out << 0.0 << ',' << 0.0 << ',' << 0.0 << ',' << std::abs(kin::orientation(x0.q).norm() - 1.0)
       << ',' << 0.0 << '\n';
@@ -110,7 +106,7 @@ Summary integrate(const body::RigidBody& rb, const body::State& x0, body::Integr
     const double momentum = (body::I_angular_momentum(rb, x) - I_L0).norm() / I_L0.norm();
     const double p_error = std::abs(kin::orientation(x.q).norm() - 1.0);
     if (!std::isfinite(T) || !std::isfinite(momentum) || !std::isfinite(p_error)) {
-      throw grbd::Error("ch02_space_donut: " + s.name +
+      throw grbd::Error(s.name +
                         " produced a non-finite state at t = " + std::to_string(n * kStep) + " s");
     }
     window_energy = std::max(window_energy, energy);
@@ -126,9 +122,7 @@ Summary integrate(const body::RigidBody& rb, const body::State& x0, body::Integr
       window_energy = window_momentum = window_p = 0.0;
     }
   }
-  if (!out) {
-    throw grbd::Error("ch02_space_donut: writing '" + file.string() + "' failed");
-  }
+  out.finish();
   return s;
 }
 

@@ -203,11 +203,11 @@ Nutation heavy_top(const std::filesystem::path& data_dir) {
   Nutation nutation;
   nutation.predicted = ode::heavy_top_nutation_bounds(top, y0);
   {
-    std::ofstream bounds = open_csv(data_dir / "nutation_bounds.csv", "u_min,u_max");
+    grbd::demo::OutputFile bounds = open_csv(data_dir / "nutation_bounds.csv", "u_min,u_max");
     bounds << nutation.predicted.u_min << ',' << nutation.predicted.u_max << '\n';
-    if (!bounds) throw grbd::Error("writing nutation_bounds.csv failed");
+    bounds.finish();
   }
-  std::ofstream out = open_csv(data_dir / "heavy_top.csv", "t_s,u,axis_x,axis_y");
+  grbd::demo::OutputFile out = open_csv(data_dir / "heavy_top.csv", "t_s,u,axis_x,axis_y");
   ode::Tolerances tolerances;
   tolerances.rtol = 1e-10;
   tolerances.atol = 1e-12;
@@ -227,15 +227,16 @@ Nutation heavy_top(const std::filesystem::path& data_dir) {
     const double t = 1e-3 * n;
     record(t, cvode.advance(t));
   }
-  if (!out) throw grbd::Error("writing heavy_top.csv failed");
+  out.finish();
   return nutation;
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
-  if (const auto exit_code = grbd::demo::check_arguments(argc, argv, "ch03_closed_forms", {"<data directory>"},
-                                   "writes heavy_top.csv and nutation_bounds.csv")) {
+  if (const auto exit_code =
+          grbd::demo::check_arguments(argc, argv, "ch03_closed_forms", {"<data directory>"},
+                                      "writes heavy_top.csv and nutation_bounds.csv")) {
     return *exit_code;
   }
   const std::filesystem::path data_dir = argv[1];

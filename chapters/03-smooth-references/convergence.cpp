@@ -58,8 +58,8 @@ struct Result {
 
 Result study(const body::RigidBody& rb, const body::State& x0, const body::IntegratorInfo& info,
              const body::State& x_ref, const std::filesystem::path& data_dir) {
-  std::ofstream out = open_csv(data_dir / (std::string(info.name) + ".csv"),
-                               "h_s,steps,angle_error_rad,omega_error_rad_s");
+  grbd::demo::OutputFile out = open_csv(data_dir / (std::string(info.name) + ".csv"),
+                                        "h_s,steps,angle_error_rad,omega_error_rad_s");
   std::vector<double> hs;
   std::vector<double> angle_errors;
   std::vector<double> omega_errors;
@@ -81,9 +81,7 @@ Result study(const body::RigidBody& rb, const body::State& x0, const body::Integ
     angle_errors.push_back(e.angle);
     omega_errors.push_back(e.omega);
   }
-  if (!out) {
-    throw grbd::Error("writing the data of " + std::string(info.name) + " failed");
-  }
+  out.finish();
   const auto finest = [](const std::vector<double>& v) {
     return std::span<const double>(v).last(kFitPoints);
   };
@@ -94,8 +92,9 @@ Result study(const body::RigidBody& rb, const body::State& x0, const body::Integ
 }  // namespace
 
 int main(int argc, char** argv) {
-  if (const auto exit_code = grbd::demo::check_arguments(argc, argv, "ch03_convergence", {"<data directory>"},
-                                   "writes <integrator>.csv for every integrator of chapter 2")) {
+  if (const auto exit_code = grbd::demo::check_arguments(
+          argc, argv, "ch03_convergence", {"<data directory>"},
+          "writes <integrator>.csv for every integrator of chapter 2")) {
     return *exit_code;
   }
   const std::filesystem::path data_dir = argv[1];

@@ -126,9 +126,7 @@ class Recorder {
     if (pending_) {
       end_window();
     }
-    if (!out_) {
-      throw grbd::Error("writing the data of " + summary_.name + " failed");
-    }
+    out_.finish();
     summary_.final_time = last_.t;
     summary_.final_energy = last_.energy;
     summary_.final_momentum = last_.momentum;
@@ -152,7 +150,7 @@ class Recorder {
   const body::RigidBody& rb_;
   double E0_;
   double L0_;
-  std::ofstream out_;
+  grbd::demo::OutputFile out_;
   Summary summary_;
   Sample last_;
   double window_energy_ = 0.0;

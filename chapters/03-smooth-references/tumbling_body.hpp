@@ -16,7 +16,6 @@
 #include <chrono>
 #include <cmath>
 #include <filesystem>
-#include <fstream>
 #include <string>
 
 #include <Eigen/Core>
@@ -29,6 +28,7 @@
 #include "grbd/kinematics/rotation.hpp"
 #include "grbd/ode/rigid_body_rhs.hpp"
 #include "grbd/ode/sundials.hpp"
+#include "grbd_demo/demo.hpp"
 
 namespace ch03 {
 
@@ -98,13 +98,11 @@ inline body::State arkode_reference(const body::RigidBody& rb, const body::State
   return ode::unpack(arkode.advance(T));
 }
 
-/// Opens `file` for writing with a header line; throws grbd::Error if it cannot.
-inline std::ofstream open_csv(const std::filesystem::path& file, const std::string& header) {
-  std::ofstream out(file);
-  if (!out) {
-    throw grbd::Error("cannot open '" + file.string() + "' for writing");
-  }
-  out << header << '\n';
+/// Opens `file` for writing with a header line, 10 significant digits; throws grbd::Error naming
+/// the file if it cannot. The caller ends it with finish(), which checks that every write worked.
+inline grbd::demo::OutputFile open_csv(const std::filesystem::path& file,
+                                       const std::string& header) {
+  grbd::demo::OutputFile out(file, header);
   out.precision(10);
   return out;
 }

@@ -45,6 +45,7 @@
 #include <iostream>
 #include <limits>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "grbd/body/integrators.hpp"
@@ -187,16 +188,14 @@ Method arkode(const body::RigidBody& rb, const body::State& x0, int order,
 }
 
 void write(const Method& method, const std::filesystem::path& data_dir) {
-  std::ofstream out =
+  grbd::demo::OutputFile out =
       open_csv(data_dir / (method.name + ".csv"),
                "parameter,rhs_evaluations,steps,seconds,angle_error_rad,omega_error_rad_s");
   for (const Run& r : method.runs) {
     out << r.parameter << ',' << r.rhs_evaluations << ',' << r.steps << ',' << r.seconds << ','
         << r.error.angle << ',' << r.error.omega << '\n';
   }
-  if (!out) {
-    throw grbd::Error("writing the data of " + method.name + " failed");
-  }
+  out.finish();
 }
 
 /// The cheapest run of all methods whose error is at most `target`, by `cost`.
@@ -223,9 +222,10 @@ void print_cheapest(const std::vector<Method>& methods, double target,
 }  // namespace
 
 int main(int argc, char** argv) {
-  if (const auto exit_code = grbd::demo::check_arguments(argc, argv, "ch03_work_precision", {"<data directory>"},
-                                   "writes <method>.csv for the integrators of chapter 2, CVODE "
-                                   "and ARKODE")) {
+  if (const auto exit_code =
+          grbd::demo::check_arguments(argc, argv, "ch03_work_precision", {"<data directory>"},
+                                      "writes <method>.csv for the integrators of chapter 2, CVODE "
+                                      "and ARKODE")) {
     return *exit_code;
   }
   const std::filesystem::path data_dir = argv[1];
@@ -240,17 +240,20 @@ int main(int argc, char** argv) {
          ode::euler_top_omega(ode::euler_top(rb.K_Theta, kin::angular_velocity(x0.u)), kEndTime))
             .norm();
 
+    // Every method's file is written as soon as its runs are done: a file that cannot be written
+    // stops the program before it measures the other methods.
     std::vector<Method> methods;
+    const auto add = [&](Method method) {
+      write(method, data_dir);
+      methods.push_back(std::move(method));
+    };
     for (const body::IntegratorInfo& info : body::integrators()) {
-      methods.push_back(fixed_step(rb, x0, info.scheme, x_ref));
+      add(fixed_step(rb, x0, info.scheme, x_ref));
     }
-    methods.push_back(cvode(rb, x0, ode::CvodeMethod::bdf, "cvode_bdf", x_ref));
-    methods.push_back(cvode(rb, x0, ode::CvodeMethod::adams, "cvode_adams", x_ref));
+    add(cvode(rb, x0, ode::CvodeMethod::bdf, "cvode_bdf", x_ref));
+    add(cvode(rb, x0, ode::CvodeMethod::adams, "cvode_adams", x_ref));
     for (const int order : {2, 4, 8}) {
-      methods.push_back(arkode(rb, x0, order, x_ref));
-    }
-    for (const Method& m : methods) {
-      write(m, data_dir);
+      add(arkode(rb, x0, order, x_ref));
     }
 
     std::printf(

@@ -34,7 +34,6 @@
 #include <cstdio>
 #include <exception>
 #include <filesystem>
-#include <fstream>
 #include <iostream>
 #include <string>
 
@@ -95,12 +94,8 @@ int region(double t) {
 }
 
 void run(const std::filesystem::path& dir) {
-  const std::filesystem::path file = dir / "contact_velocity.csv";
-  std::ofstream out(file);
-  if (!out) {
-    throw grbd::Error("ch04_contact_velocity: cannot open '" + file.string() + "' for writing");
-  }
-  out << "t_s,g_N,gamma_N,g_N_dot,region,gamma_T1,gamma_T2\n";
+  grbd::demo::OutputFile out(dir / "contact_velocity.csv",
+                             "t_s,g_N,gamma_N,g_N_dot,region,gamma_T1,gamma_T2");
   out.precision(12);
 
   double max_deviation = 0.0;
@@ -135,18 +130,20 @@ void run(const std::filesystem::path& dir) {
     min_gap = std::min(min_gap, g.g_N);
     ++regions_seen[r];
   }
+  out.finish();
   std::printf(
       "ch04_contact_velocity: max |gamma_N - dg_N/dt| = %.2e m/s (max |gamma_N| = %.3f m/s), "
       "min g_N = %.4f m; samples inside/face/edge/vertex region: %d/%d/%d/%d; wrote %s\n",
       max_deviation, max_gamma, min_gap, regions_seen[0], regions_seen[1], regions_seen[2],
-      regions_seen[3], file.string().c_str());
+      regions_seen[3], out.path().string().c_str());
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
-  if (const auto exit_code = grbd::demo::check_arguments(argc, argv, "ch04_contact_velocity", {"<data directory>"},
-                                   "writes contact_velocity.csv into the existing directory")) {
+  if (const auto exit_code =
+          grbd::demo::check_arguments(argc, argv, "ch04_contact_velocity", {"<data directory>"},
+                                      "writes contact_velocity.csv into the existing directory")) {
     return *exit_code;
   }
   try {

@@ -168,13 +168,10 @@ double load_average() {
 }
 
 void run(const std::filesystem::path& dir) {
-  const std::filesystem::path file = dir / "scaling.csv";
-  std::ofstream out(file);
-  if (!out) {
-    throw grbd::Error("ch04_scaling: cannot open '" + file.string() + "' for writing");
-  }
-  out << "N,ns_per_body_random,ns_per_body_morton,pairs_per_body,morton_order_ns_per_body,cells,"
-         "build_ns_random,pairs_ns_random,build_ns_morton,pairs_ns_morton\n";
+  grbd::demo::OutputFile out(
+      dir / "scaling.csv",
+      "N,ns_per_body_random,ns_per_body_morton,pairs_per_body,morton_order_ns_per_body,cells,"
+      "build_ns_random,pairs_ns_random,build_ns_morton,pairs_ns_morton");
   std::printf("ch04_scaling: %u hardware threads, load average %.2f at the start\n",
               std::thread::hardware_concurrency(), load_average());
   std::printf("%9s %14s %14s %10s %14s %10s\n", "N", "random ns/body", "morton ns/body",
@@ -228,15 +225,17 @@ void run(const std::filesystem::path& dir) {
                   same ? "equal" : "DIFFER FROM");
     }
   }
+  out.finish();
   std::printf("ch04_scaling: load average %.2f at the end; wrote %s\n", load_average(),
-              file.string().c_str());
+              out.path().string().c_str());
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
-  if (const auto exit_code = grbd::demo::check_arguments(argc, argv, "ch04_scaling", {"<data directory>"},
-                                   "writes scaling.csv into the existing directory")) {
+  if (const auto exit_code =
+          grbd::demo::check_arguments(argc, argv, "ch04_scaling", {"<data directory>"},
+                                      "writes scaling.csv into the existing directory")) {
     return *exit_code;
   }
   try {

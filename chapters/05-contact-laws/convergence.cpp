@@ -22,7 +22,6 @@
 #include <cstdio>
 #include <exception>
 #include <filesystem>
-#include <fstream>
 #include <iostream>
 #include <string>
 #include <vector>
@@ -70,10 +69,9 @@ SolverResult solve(const std::string& solver, const ContactProblem& problem,
 /// Writes histories as columns; a history that ended leaves its field empty.
 void write_columns(const std::filesystem::path& path, const std::vector<std::string>& names,
                    const std::vector<SolverResult>& results) {
-  std::ofstream out(path);
-  out << 'k';
-  for (const std::string& name : names) out << ',' << name;
-  out << '\n';
+  std::string header = "k";
+  for (const std::string& name : names) header += ',' + name;
+  grbd::demo::OutputFile out(path, header);
   std::size_t rows = 0;
   for (const SolverResult& r : results) rows = std::max(rows, r.history.size());
   char field[32];
@@ -88,30 +86,32 @@ void write_columns(const std::filesystem::path& path, const std::vector<std::str
     }
     out << '\n';
   }
-  if (!out) throw std::runtime_error("cannot write " + path.string());
+  out.finish();
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
-  if (const auto exit_code = grbd::demo::check_arguments(argc, argv, kProgram, {"<data directory>"},
-                                   "writes convergence.csv, deep.csv, alpha.csv and convergence.txt")) {
+  if (const auto exit_code = grbd::demo::check_arguments(
+          argc, argv, kProgram, {"<data directory>"},
+          "writes convergence.csv, deep.csv, alpha.csv and convergence.txt")) {
     return *exit_code;
   }
   try {
     const std::filesystem::path dir = argv[1];
     grbd::demo::SpherePile pile = grbd::demo::sphere_pile(8, 8, 1);
     ContactSolution first;
-    const SolverResult first_result = grbd::contact::solve_sor(pile.problem, first, options_for("SOR"));
+    const SolverResult first_result =
+        grbd::contact::solve_sor(pile.problem, first, options_for("SOR"));
     grbd::contact::WarmStart previous;
     previous.store(pile.problem.keys, first.lambda);
     grbd::demo::advance(pile, first.u);
 
-    std::ofstream table(dir / "convergence.txt");
+    grbd::demo::OutputFile table(dir / "convergence.txt");
     char line[256];
-    std::snprintf(line, sizeof line,
-                  "%zu spheres, %zu contacts; first step: %s\n", pile.problem.M_inv.size(),
-                  pile.problem.contacts.size(), grbd::contact::describe(first_result).c_str());
+    std::snprintf(line, sizeof line, "%zu spheres, %zu contacts; first step: %s\n",
+                  pile.problem.M_inv.size(), pile.problem.contacts.size(),
+                  grbd::contact::describe(first_result).c_str());
     table << line;
     std::cout << line;
 
@@ -124,8 +124,8 @@ int main(int argc, char** argv) {
         if (warm) found = previous.initialize(pile.problem.keys, solution.lambda);
         const SolverResult result = solve(solver, pile.problem, solution, options_for(solver));
         std::snprintf(line, sizeof line, "%-5s %-4s (%zu of %zu contacts warm): %s\n",
-                      solver.c_str(), warm ? "warm" : "cold", found,
-                      pile.problem.contacts.size(), grbd::contact::describe(result).c_str());
+                      solver.c_str(), warm ? "warm" : "cold", found, pile.problem.contacts.size(),
+                      grbd::contact::describe(result).c_str());
         table << line;
         std::cout << line;
         names.push_back(warm ? solver + "_warm" : solver);
@@ -164,7 +164,7 @@ int main(int argc, char** argv) {
       alpha_results.push_back(result);
     }
     write_columns(dir / "alpha.csv", alpha_names, alpha_results);
-    if (!table) throw std::runtime_error("cannot write convergence.txt");
+    table.finish();
     return 0;
   } catch (...) {
     return grbd::demo::report_exception(kProgram, "Exercises 5.1-5.8");

@@ -14,18 +14,26 @@
 //
 // Usage:
 //   ch05_fclib <data directory> <FCLIB file or folder>... [--tol T] [--max-iterations N]
+// with T a finite number > 0 and N a whole number from 1 to INT_MAX (CLI11 reads the command
+// line); a bad argument exits with 2 and a message that names it.
 // Output, in the data directory:
 //   fclib.txt   the table printed to standard output
 //   fclib.csv   problem, solver, k, ‖F‖/‖q‖: every run's history, one row per iteration
 
+#include <CLI/CLI.hpp>
+
 #include <algorithm>
+#include <charconv>
+#include <climits>
+#include <cmath>
 #include <cstdio>
-#include <cstdlib>
 #include <exception>
 #include <filesystem>
-#include <fstream>
 #include <iostream>
+#include <memory>
+#include <optional>
 #include <string>
+#include <system_error>
 #include <vector>
 
 #include "grbd/contact/fclib.hpp"
@@ -41,21 +49,101 @@ using grbd::contact::SolverOptions;
 using grbd::contact::SolverResult;
 
 constexpr const char* kProgram = "ch05_fclib";
+constexpr const char* kUsage =
+    "usage: ch05_fclib <data directory> <FCLIB file or folder>... [--tol T] [--max-iterations N]\n"
+    "  solves FCLIB problems with SOR, JOR and APGD; writes fclib.txt and fclib.csv\n";
 
-/// Prints the usage, after `problem` if there is one, to `out`; returns the exit code 2.
-int usage(const std::string& problem, std::ostream& out = std::cerr) {
-  if (!problem.empty()) out << kProgram << ": " << problem << '\n';
-  out << "usage: " << kProgram
-      << " <data directory> <FCLIB file or folder>... [--tol T] [--max-iterations N]\n"
-         "  solves FCLIB problems with SOR, JOR and APGD; writes fclib.txt and fclib.csv\n";
+/// CLI11's help, which starts with the usage line of the other demos instead of CLI11's own.
+class Help : public CLI::Formatter {
+ public:
+  std::string make_usage(const CLI::App* /*app*/, std::string /*name*/) const override {
+    return kUsage;
+  }
+};
+
+/// Prints `problem` and the usage to std::cerr; returns the exit code 2 of a bad command line.
+int refuse(const std::string& problem) {
+  std::cerr << kProgram << ": " << problem << '\n' << kUsage;
   return 2;
 }
 
-/// Parses a number option's value or returns false.
-bool parse_number(const std::string& text, double& value) {
-  char* end = nullptr;
-  value = std::strtod(text.c_str(), &end);
-  return !text.empty() && end == text.c_str() + text.size();
+/// The value of --max-iterations: a whole number in decimal from 1 to INT_MAX, nothing else
+/// ("1e3", "2.7", "inf", "0x10" and "3e9" are refused). CLI11 on its own would read integers with
+/// strtoll's base 0, "0x10" as 16 and "010" as 8, so the accepted text is also rewritten in plain
+/// decimal before CLI11 converts it.
+CLI::Validator whole_number() {
+  return CLI::Validator(
+      [](std::string& text) -> std::string {
+        const char* const end = text.data() + text.size();
+        int value = 0;
+        const auto [stop, error] = std::from_chars(text.data(), end, value);
+        if (text.empty() || stop != end || error == std::errc::invalid_argument) {
+          return "expects a whole number, found '" + text + "'";
+        }
+        if (error == std::errc::result_out_of_range || value < 1) {
+          return "expects a whole number from 1 to " + std::to_string(INT_MAX) + ", found '" +
+                 text + "'";
+        }
+        text = std::to_string(value);
+        return {};
+      },
+      "");  // no description: the option's own says what it takes
+}
+
+/// The value of --tol: a finite positive number in decimal notation ("inf", "nan", "-1", "0" and
+/// hexadecimal are refused). The accepted text is rewritten with 17 significant digits, which
+/// CLI11's conversion (strtold) reads back as exactly the double std::from_chars found.
+CLI::Validator finite_positive() {
+  return CLI::Validator(
+      [](std::string& text) -> std::string {
+        const bool plus = text.starts_with('+');  // strtod, which this option used, took a '+'
+        const char* const first = text.data() + (plus ? 1 : 0);
+        const char* const end = text.data() + text.size();
+        double value = 0.0;
+        const auto [stop, error] = std::from_chars(first, end, value);
+        if (first == end || stop != end || error == std::errc::invalid_argument ||
+            (plus && *first == '-')) {
+          return "expects a number, found '" + text + "'";
+        }
+        if (error == std::errc::result_out_of_range || !std::isfinite(value) || !(value > 0.0)) {
+          return "expects a finite positive number, found '" + text + "'";
+        }
+        char digits[32];
+        const auto written =
+            std::to_chars(digits, digits + sizeof digits, value, std::chars_format::general, 17);
+        text.assign(digits, written.ptr);
+        return {};
+      },
+      "");
+}
+
+/// Adds the FCLIB files that `argument` names to `files`: the file itself, or every *.hdf5 in the
+/// folder, in name order. Returns why it cannot, or std::nullopt. Uses the std::error_code
+/// overloads of std::filesystem throughout: the throwing ones would end the program on a
+/// symbolic-link loop, an overlong name or an unreadable folder.
+std::optional<std::string> collect(const std::string& argument, std::vector<fs::path>& files) {
+  std::error_code error;
+  const fs::file_status status = fs::status(argument, error);
+  if (error) {
+    return "cannot use '" + argument + "' as an FCLIB file or folder: " + error.message();
+  }
+  if (fs::is_directory(status)) {
+    std::vector<fs::path> found;
+    for (fs::directory_iterator entry(argument, error), end; !error && entry != end;
+         entry.increment(error)) {
+      if (entry->path().extension() == ".hdf5") found.push_back(entry->path());
+    }
+    if (error) return "cannot read the folder '" + argument + "': " + error.message();
+    if (found.empty()) return "the folder '" + argument + "' holds no *.hdf5 file";
+    std::sort(found.begin(), found.end());
+    files.insert(files.end(), found.begin(), found.end());
+    return std::nullopt;
+  }
+  if (fs::is_regular_file(status)) {
+    files.emplace_back(argument);
+    return std::nullopt;
+  }
+  return "'" + argument + "' is neither an FCLIB file nor a folder";
 }
 
 struct Run {
@@ -68,53 +156,58 @@ struct Run {
 }  // namespace
 
 int main(int argc, char** argv) {
-  if (grbd::demo::wants_help(argc, argv)) {
-    usage("", std::cout);
+  std::string data_directory;
+  std::vector<std::string> inputs;
+  double tol = 1e-8;
+  int max_iterations = 20000;
+  CLI::App app("", kProgram);  // no description: the help starts with the usage line
+  app.formatter(std::make_shared<Help>());
+  app.add_option("data directory", data_directory,
+                 "an existing folder, where fclib.txt and fclib.csv are written")
+      ->type_name("")
+      ->required();
+  app.add_option("FCLIB file or folder", inputs,
+                 "FCLIB problems (HDF5), or folders whose *.hdf5 files are all solved")
+      ->type_name("")
+      ->required();
+  app.add_option("--tol", tol, "stop once |F| <= T |q|; T a finite number > 0, by default 1e-8")
+      ->transform(finite_positive())
+      ->type_name("T")
+      ->multi_option_policy(CLI::MultiOptionPolicy::TakeLast);
+  app.add_option("--max-iterations", max_iterations,
+                 "at most N iterations per solver and problem; N a whole number from 1 to " +
+                     std::to_string(INT_MAX) + ", by default 20000")
+      ->transform(whole_number())
+      ->type_name("N")
+      ->multi_option_policy(CLI::MultiOptionPolicy::TakeLast);
+  if (grbd::demo::wants_help(argc, argv)) {  // any -h or --help, as in every demo
+    std::cout << app.help();
     return 0;
   }
-  if (argc < 3) return usage("");
-  const fs::path dir = argv[1];
-  if (!fs::is_directory(dir)) {
-    return usage("the data directory '" + dir.string() + "' does not exist or is not a directory");
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp&) {
+    std::cout << app.help();
+    return 0;
+  } catch (const CLI::ParseError& e) {
+    return refuse(e.what());
   }
-  double tol = 1e-8;
-  double max_iterations = 20000;
+
+  const fs::path dir = data_directory;
+  if (const auto reason = grbd::demo::not_a_directory(dir)) {
+    return refuse(grbd::demo::directory_message("data directory", dir, *reason));
+  }
   std::vector<fs::path> files;
-  for (int a = 2; a < argc; ++a) {
-    const std::string arg = argv[a];
-    if (arg == "--tol" || arg == "--max-iterations") {
-      double value = 0.0;
-      if (a + 1 >= argc || !parse_number(argv[a + 1], value) || !(value > 0.0)) {
-        return usage(arg + " expects a positive number, found '" +
-                     (a + 1 < argc ? std::string(argv[a + 1]) : std::string()) + "'");
-      }
-      (arg == "--tol" ? tol : max_iterations) = value;
-      ++a;
-    } else if (arg.starts_with("--")) {
-      return usage("unknown option '" + arg + "'");
-    } else if (fs::is_directory(arg)) {
-      std::vector<fs::path> found;
-      for (const auto& entry : fs::directory_iterator(arg)) {
-        if (entry.path().extension() == ".hdf5") found.push_back(entry.path());
-      }
-      std::sort(found.begin(), found.end());
-      if (found.empty()) return usage("the folder '" + arg + "' holds no *.hdf5 file");
-      files.insert(files.end(), found.begin(), found.end());
-    } else if (fs::is_regular_file(arg)) {
-      files.emplace_back(arg);
-    } else {
-      return usage("'" + arg + "' is neither an FCLIB file nor a folder");
-    }
+  for (const std::string& input : inputs) {
+    if (const auto problem = collect(input, files)) return refuse(*problem);
   }
-  if (files.empty()) return usage("no FCLIB file given");
 
   try {
-    std::ofstream table(dir / "fclib.txt");
-    std::ofstream history(dir / "fclib.csv");
-    history << "problem,solver,k,relative_residual\n";
+    grbd::demo::OutputFile table(dir / "fclib.txt");
+    grbd::demo::OutputFile history(dir / "fclib.csv", "problem,solver,k,relative_residual");
     char line[512];
-    std::snprintf(line, sizeof line, "%-44s %-12s %4s %9s %10s %10s %10s %s\n", "problem",
-                  "solver", "n", "iter", "|F|/|q|", "|F|/max", "time [ms]", "");
+    std::snprintf(line, sizeof line, "%-44s %-12s %4s %9s %10s %10s %10s %s\n", "problem", "solver",
+                  "n", "iter", "|F|/|q|", "|F|/max", "time [ms]", "");
     table << line;
     std::cout << line;
 
@@ -123,7 +216,7 @@ int main(int argc, char** argv) {
       run.options.criterion = grbd::contact::Criterion::natural_residual;
       run.options.abs_tol = 0.0;
       run.options.rel_tol = tol;
-      run.options.max_iterations = static_cast<int>(max_iterations);
+      run.options.max_iterations = max_iterations;
       run.options.record_history = true;
     }
     runs[0].name = "SOR-AC";
@@ -155,8 +248,8 @@ int main(int argc, char** argv) {
                       : grbd::contact::solve_sor(problem, lambda, run.options);
         std::snprintf(line, sizeof line, "%-44s %-12s %4zu %9d %10.2e %10.2e %10.2f %s\n",
                       name.c_str(), run.name.c_str(), problem.q.size(), result.iterations,
-                      result.relative_residual(), result.scaled_residual(),
-                      1e3 * result.seconds, result.converged ? "" : "NOT converged");
+                      result.relative_residual(), result.scaled_residual(), 1e3 * result.seconds,
+                      result.converged ? "" : "NOT converged");
         table << line;
         std::cout << line;
         for (std::size_t k = 0; k < result.history.size(); ++k) {
@@ -166,7 +259,8 @@ int main(int argc, char** argv) {
         }
       }
     }
-    if (!table || !history) throw std::runtime_error("cannot write fclib.txt or fclib.csv");
+    table.finish();
+    history.finish();
     return 0;
   } catch (...) {
     return grbd::demo::report_exception(kProgram, "Exercises 5.1-5.8");

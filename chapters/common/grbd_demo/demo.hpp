@@ -1,16 +1,23 @@
 #pragma once
 /// \file
-/// \brief What every chapter demo does the same way: answer `--help`, check its command line, and
-/// turn an exception into a message and an exit code (0 help, 2 bad arguments, 3 a missing
-/// exercise, 1 any other error).
+/// \brief What every chapter demo does the same way: answer `--help`, check its command line, write
+/// its output files, and turn an exception into a message and an exit code (0 help, 2 bad
+/// arguments, 3 a missing exercise, 1 any other error).
+///
+/// Every message a demo prints starts with the program's name exactly once: report_exception() and
+/// the argument checks add it, so the messages of the exceptions a demo throws never start with it.
 
+#include <cerrno>
 #include <exception>
 #include <filesystem>
+#include <fstream>
 #include <initializer_list>
 #include <iostream>
 #include <optional>
 #include <string>
 #include <string_view>
+#include <system_error>
+#include <utility>
 
 #include "grbd/core/error.hpp"
 
@@ -23,6 +30,26 @@ inline bool wants_help(int argc, char** argv) {
     if (argument == "-h" || argument == "--help") return true;
   }
   return false;
+}
+
+/// Why `path` is not an existing directory, or std::nullopt when it is one: the system's reason
+/// ("No such file or directory", "Not a directory" for a path through a regular file, "Too many
+/// levels of symbolic links", "File name too long", "Permission denied", ...) or "not a directory"
+/// for an existing file of another type. Never throws: it asks std::filesystem::status with a
+/// std::error_code, since the throwing overloads of std::filesystem end a demo with an uncaught
+/// std::filesystem::filesystem_error on a symbolic-link loop or an overlong name.
+inline std::optional<std::string> not_a_directory(const std::filesystem::path& path) {
+  std::error_code error;
+  const std::filesystem::file_status status = std::filesystem::status(path, error);
+  if (error) return error.message();
+  if (!std::filesystem::is_directory(status)) return std::string("not a directory");
+  return std::nullopt;
+}
+
+/// The message for an unusable directory argument: "cannot use the <what> '<path>': <reason>".
+inline std::string directory_message(std::string_view what, const std::filesystem::path& path,
+                                     std::string_view reason) {
+  return "cannot use the " + std::string(what) + " '" + path.string() + "': " + std::string(reason);
 }
 
 /// Checks `program <data directory> [further arguments]`: exactly arguments.size() arguments, the
@@ -46,14 +73,61 @@ inline std::optional<int> check_arguments(int argc, char** argv, std::string_vie
     print_usage(std::cerr);
     return 2;
   }
-  std::error_code error;  // is_directory without an error code throws on a symlink loop
-  if (!std::filesystem::is_directory(argv[1], error)) {
-    std::cerr << program << ": the data directory '" << argv[1] << "' does not exist or is not a "
-              << "directory" << (error ? " (" + error.message() + ")" : std::string()) << '\n';
+  if (const auto reason = not_a_directory(argv[1])) {
+    std::cerr << program << ": " << directory_message("data directory", argv[1], *reason) << '\n';
     return 2;
   }
   return std::nullopt;
 }
+
+/// A file a demo writes: a std::ofstream that knows its path and reports every failure as a
+/// grbd::Error naming the file, with the system's reason where there is one. A stream only reports
+/// a failed write once its buffer reaches the disk, which for the last few kilobytes is at the
+/// close: a file is therefore complete, and checked, only after finish(), which every demo calls
+/// once it has written everything (the destructor closes silently, after an exception).
+class OutputFile : public std::ofstream {
+ public:
+  /// Opens (or truncates) `path` for writing; throws grbd::Error if it cannot. A non-empty
+  /// `header` is written as the first line and flushed at once, so that a file that cannot be
+  /// written (a full disk) fails here, before the demo computes what goes into it.
+  explicit OutputFile(std::filesystem::path path, std::string_view header = {})
+      : path_(std::move(path)) {
+    errno = 0;
+    open(path_);
+    if (!is_open()) raise("cannot open", " for writing");
+    if (!header.empty()) {
+      *this << header << '\n';
+      errno = 0;
+      flush();
+      if (!good()) raise("cannot write", "");
+    }
+  }
+
+  // Movable (a function may open and return one), written out because the defaulted move would
+  // copy the virtual base std::basic_ios.
+  OutputFile(OutputFile&& other) noexcept
+      : std::ofstream(std::move(other)), path_(std::move(other.path_)) {}
+  OutputFile& operator=(OutputFile&&) = delete;
+
+  /// The file's path.
+  const std::filesystem::path& path() const noexcept { return path_; }
+
+  /// Flushes and closes the file; throws grbd::Error naming it if this or any earlier write failed.
+  void finish() {
+    errno = 0;
+    close();  // flushes the buffer; sets failbit if that fails
+    if (fail()) raise("cannot write", "");
+  }
+
+ private:
+  [[noreturn]] void raise(std::string_view what, std::string_view how) const {
+    const int reason = errno;
+    throw Error(std::string(what) + " '" + path_.string() + "'" + std::string(how) +
+                (reason != 0 ? ": " + std::generic_category().message(reason) : std::string()));
+  }
+
+  std::filesystem::path path_;
+};
 
 /// Call from a `catch (...)` block: prints the exception being handled and returns the demo's exit
 /// code, 3 for grbd::NotImplemented (the student build before the exercises the demo `needs` are
