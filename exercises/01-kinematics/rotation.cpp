@@ -5,9 +5,11 @@
 /// inverse, the quaternion of a rotation matrix (Shepperd's method).
 
 #include "grbd/kinematics/rotation.hpp"
+#include "grbd/core/checks.hpp"
 #include "grbd/core/error.hpp"
 #include "grbd/kinematics/skew.hpp"
 
+#include <Eigen/LU>  // determinant()
 #include <cmath>
 
 namespace grbd::kinematics {
@@ -22,6 +24,16 @@ Matrix3 rotation_matrix(const Quaternion& p) {
 }
 
 Quaternion quaternion_from_rotation_matrix(const Matrix3& R) {
+  // Not part of the exercise: Shepperd's method turns any matrix into some unit quaternion (the
+  // zero matrix into the identity), so a matrix that is not a rotation is refused first. 1e-6
+  // admits rotations orthogonal only to round-off or to six printed digits.
+  if (!is_rotation_matrix(R, 1e-6)) {
+    throw InvalidArgument(
+        "quaternion_from_rotation_matrix: expected a rotation matrix (max |RᵀR − I| ≤ 1e-6 and "
+        "|det R − 1| ≤ 1e-6), found max |RᵀR − I| = " +
+        format_number((R.transpose() * R - Matrix3::Identity()).cwiseAbs().maxCoeff()) +
+        " and det R = " + format_number(R.determinant()));
+  }
   // EXERCISE 1.4: the quaternion of a rotation matrix (Shepperd's method)
   // Hint: for |p| = 1 the diagonal of R(p) gives the squares pi², R_ij ± R_ji the products.
   // Hint: a square root of a small number is ill-conditioned: take only the largest one.

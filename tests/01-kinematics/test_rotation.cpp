@@ -16,6 +16,7 @@
 #include <array>
 #include <cmath>
 #include <numbers>
+#include <string>
 #include <vector>
 
 #include "grbd/core/error.hpp"
@@ -270,6 +271,37 @@ TEST(Exercise1_4, HalfTurnsAboutCoordinateAxes) {
   }
   EXPECT_EQ(quaternion_from_rotation_matrix(Matrix3::Identity()).coeffs(),
             Quaternion::identity().coeffs());
+}
+
+// Reference: issue 11 (fuzzing) and the definition of SO(3) (RᵀR = I, det R = +1):
+// quaternion_from_rotation_matrix(0) returned the identity. A matrix that is not a rotation to
+// 1e-6 (the zero matrix, a reflection, a scaled or sheared rotation, NaN) must be refused with
+// grbd::InvalidArgument naming the function, what was expected and what was found; rotations
+// that are orthogonal only to round-off (here 1e-9) are still accepted. Not an exercise suite:
+// the check lies outside the exercise region, so it holds for the stubs as well.
+TEST(QuaternionFromRotationMatrix, RefusesMatricesThatAreNotRotations) {
+  grbd::test::Random rng(1404);
+  const Matrix3 R = axis_angle_matrix(rng.unit_vector3(), 1.3);
+  Matrix3 sheared = R;
+  sheared(0, 1) += 1e-3;
+  const std::array<Matrix3, 6> bad = {
+      Matrix3::Zero(), Matrix3(Vector3(1.0, 1.0, -1.0).asDiagonal()),
+      Matrix3(-R),     Matrix3(2.0 * R),
+      sheared,         Matrix3::Constant(std::nan(""))};
+  for (const Matrix3& M : bad) {
+    std::string message;
+    try {
+      (void)quaternion_from_rotation_matrix(M);
+      ADD_FAILURE() << "accepted a matrix that is not a rotation:\n" << M;
+    } catch (const grbd::InvalidArgument& error) {
+      message = error.what();
+    }
+    EXPECT_EQ(message.rfind("quaternion_from_rotation_matrix: expected a rotation matrix", 0), 0U)
+        << message;
+    EXPECT_NE(message.find("found"), std::string::npos) << message;
+    EXPECT_NE(message.find("det R"), std::string::npos) << message;
+  }
+  EXPECT_NO_THROW((void)quaternion_from_rotation_matrix((1.0 + 1e-9) * R));
 }
 
 // ----------------------------------------------------------------------------------------------

@@ -955,3 +955,18 @@ TEST(IntegratorInput, RefusesNonUnitQuaternionsNonFiniteStatesAndLoads) {
   EXPECT_THROW(grbd::body::kinetic_energy(RigidBody{-1.0, Vector3::Ones()}, Vector6::Ones()),
                grbd::InvalidArgument);
 }
+
+// Regression (issue 11): moments that break the triangle inequality, (1, 1, 5), were accepted;
+// no mass distribution has them (Θ_k = ∫(x_i² + x_j²) dm ≤ Θ_i + Θ_j). A rod and a plate meet
+// the inequality with equality and pass.
+TEST(RigidBodyInput, RefusesMomentsThatBreakTheTriangleInequality) {
+  try {
+    grbd::body::require_valid(RigidBody{1.0, Vector3(1.0, 1.0, 5.0)}, "test");
+    ADD_FAILURE() << "(1, 1, 5) was accepted";
+  } catch (const grbd::InvalidArgument& error) {
+    EXPECT_NE(std::string(error.what()).find("triangle inequality"), std::string::npos)
+        << error.what();
+  }
+  EXPECT_NO_THROW(grbd::body::require_valid(RigidBody{1.0, Vector3(1.0, 1.0, 2.0)}, "plate"));
+  EXPECT_NO_THROW(grbd::body::require_valid(RigidBody{1.0, Vector3(1.0, 1.0, 1e-9)}, "rod"));
+}

@@ -62,6 +62,18 @@ double relative(const Matrix3& found, const Matrix3& expected) {
   return max_abs(found - expected) / max_abs(expected);
 }
 
+/// The message of the grbd::InvalidArgument that `call` throws, or a failure if it throws none.
+template <class F>
+std::string invalid_argument_message(F&& call) {
+  try {
+    call();
+  } catch (const grbd::InvalidArgument& error) {
+    return error.what();
+  }
+  ADD_FAILURE() << "expected a grbd::InvalidArgument, none was thrown";
+  return {};
+}
+
 /// The parallel-axis term m (dᵀd I − d dᵀ) for a shift d.
 Matrix3 steiner(double mass, const Vector3& d) {
   return mass * (d.squaredNorm() * Matrix3::Identity() - d * d.transpose());
@@ -646,6 +658,87 @@ TEST(PrincipalAxes, RejectsNonFiniteAndNonSymmetricTensors) {
   Theta = Matrix3::Identity();
   Theta(2, 2) = std::nan("");
   EXPECT_THROW(principal_axes(Theta), grbd::InvalidArgument);
+}
+
+// Reference: issue 11 (fuzzing): a NaN in Θ was reported as an asymmetry ("max |Θ − Θᵀ| =
+// nan"); it must be called not finite, with the entry.
+TEST(PrincipalAxes, CallsANaNEntryNotFinite) {
+  for (const double bad : {std::nan(""), std::numeric_limits<double>::infinity()}) {
+    Matrix3 Theta = Matrix3::Identity();
+    Theta(1, 2) = Theta(2, 1) = bad;
+    const std::string message = invalid_argument_message([&] { principal_axes(Theta); });
+    EXPECT_NE(message.find("not finite"), std::string::npos) << message;
+    EXPECT_NE(message.find("(1, 2)"), std::string::npos) << message;
+    EXPECT_EQ(message.find("symmetric"), std::string::npos) << message;
+  }
+}
+
+// Reference: issue 11 (fuzzing) and the definition Θ = ∫ (|x|² I − x xᵀ) dm: for any unit axis
+// e, eᵀΘe = ∫ |x − (eᵀx) e|² dm ≥ 0, so no principal moment is negative, and
+// Θ1 + Θ2 − Θ3 = 2 ∫ x3² dm ≥ 0 in the principal frame (the triangle inequality, Θ3 the
+// largest). A negative moment and (1, 1, 5) were accepted.
+TEST(PrincipalAxes, RejectsNegativeMomentsAndTheBrokenTriangleInequality) {
+  grbd::test::Random rng(2404);
+  const Matrix3 A = rng.rotation();
+  const std::array<Vector3, 3> impossible = {Vector3(-1.0, 2.0, 3.0), Vector3(1.0, 1.0, 5.0),
+                                             Vector3(1.0, 2.0, 3.0 + 1e-6)};
+  for (const Vector3& d : impossible) {
+    const Matrix3 Theta = A * d.asDiagonal() * A.transpose();
+    const std::string message = invalid_argument_message([&] { principal_axes(Theta); });
+    EXPECT_EQ(message.rfind("principal_axes: ", 0), 0U) << message;
+    EXPECT_NE(message.find(d[0] < 0.0 ? "Θ1 ≥ 0" : "Θ1 + Θ2 ≥ Θ3"), std::string::npos) << message;
+    EXPECT_NE(message.find("found"), std::string::npos) << message;
+  }
+  const std::string message =
+      invalid_argument_message([&] { principal_axes(Matrix3(Vector3(1, 1, 5).asDiagonal())); });
+  EXPECT_NE(message.find("(1, 1, 5)"), std::string::npos) << message;
+}
+
+// Reference: the equality cases of the inequalities above: a thin rod (0, m, m)·L²/12 has a zero
+// moment and Θ1 + Θ2 = Θ3 up to the vanishing one; a flat plate has Θ1 + Θ2 = Θ3 exactly. Both
+// are physical limits and must pass, rotated (round-off of 1e-16 relative in Θ), and so must a
+// box mesh 10⁻⁷ thick, whose mesh-integrated moments meet the plate's equality to round-off.
+TEST(PrincipalAxes, AcceptsTheEqualityCasesOfRodsAndPlates) {
+  grbd::test::Random rng(2405);
+  for (int n = 0; n < 200; ++n) {
+    const Matrix3 A = rng.rotation();
+    const double a = rng.uniform(0.1, 2.0);
+    const double b = rng.uniform(0.1, 2.0);
+    for (const Vector3& d : {Vector3(0.0, a, a), Vector3(a, b, a + b), Vector3(a, a, 2.0 * a)}) {
+      const Matrix3 Theta = A * d.asDiagonal() * A.transpose();
+      EXPECT_NO_THROW(principal_axes(Theta)) << describe("moments", d, "rotation", A);
+    }
+  }
+  for (int n = 0; n < 20; ++n) {
+    const TriangleMesh plate = grbd::body::transformed(
+        grbd::body::box_mesh(Vector3(0.5, 0.3, 1e-7)), rng.rotation(), rng.vector3(-1, 1));
+    const MassProperties props = mass_properties(plate, 1000.0);
+    EXPECT_NO_THROW(principal_axes(props.M_Theta_S));
+  }
+}
+
+// Reference: issue 11 (fuzzing): a box of half-extent 1e100 has a finite volume (8e300) but
+// second moments ∫ x xᵀ dV ≈ 1e500 that overflow; the mass properties came out inf/NaN. They must
+// be refused as coordinates too large, naming the source and the size of the mesh. A finite mesh
+// with a density so large that m = ρV overflows names the density instead.
+TEST(MassProperties, NamesOverflowingIntegralsAndMass) {
+  const TriangleMesh huge = grbd::body::box_mesh(Vector3::Constant(1e100));
+  std::string message;
+  try {
+    mass_properties(huge, 1.0, "huge.obj");
+    ADD_FAILURE() << "the inertia of a box of 1e100 overflows";
+  } catch (const grbd::body::MeshError& error) {
+    message = error.what();
+  }
+  EXPECT_EQ(message.rfind("huge.obj: ", 0), 0U) << message;
+  EXPECT_NE(message.find("coordinates too large"), std::string::npos) << message;
+  EXPECT_NE(message.find("1e+100"), std::string::npos) << message;
+
+  const TriangleMesh box = grbd::body::box_mesh(Vector3::Ones());
+  message = invalid_argument_message([&] { mass_properties(box, 1e308, "box.obj"); });
+  EXPECT_EQ(message.rfind("mass_properties (box.obj): ", 0), 0U) << message;
+  EXPECT_NE(message.find("density"), std::string::npos) << message;
+  EXPECT_NE(message.find("overflow"), std::string::npos) << message;
 }
 
 // ----------------------------------------------------------------------------------------------

@@ -17,7 +17,9 @@
 #include <Eigen/LU>        // determinant()
 #include <algorithm>
 #include <array>
+#include <cerrno>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -26,8 +28,11 @@
 #include <random>
 #include <set>
 #include <string>
+#include <system_error>
 #include <utility>
 #include <vector>
+
+#include <sys/stat.h>  // mkfifo
 
 #include "grbd/body/triangle_mesh.hpp"
 #include "grbd/core/error.hpp"
@@ -319,6 +324,163 @@ TEST(ObjReader, NamesAMissingOrUnreadableFile) {
     const std::string device = mesh_error_message([&] { read_obj("/dev/zero"); });
     EXPECT_NE(device.find("not a regular file"), std::string::npos) << device;
   }
+}
+
+// Reference: issue 11 (fuzzing): a path that exists but cannot be examined (a loop of symbolic
+// links, a name component longer than NAME_MAX) was reported as "no such file". The message must
+// give the operating system's reason instead, and "no such file" only for a missing file.
+TEST(ObjReader, DistinguishesAMissingFileFromOneThatCannotBeExamined) {
+  const TempDir dir;
+  const fs::path loop = dir.path() / "loop.obj";
+  fs::create_symlink(dir.path() / "loop_back.obj", loop);
+  fs::create_symlink(loop, dir.path() / "loop_back.obj");
+  std::string message = mesh_error_message([&] { read_obj(loop); });
+  EXPECT_EQ(message.rfind(loop.string() + ": ", 0), 0U) << message;
+  EXPECT_EQ(message.find("no such file"), std::string::npos) << message;
+  EXPECT_NE(message.find(std::make_error_code(std::errc::too_many_symbolic_link_levels).message()),
+            std::string::npos)
+      << message;
+
+  const fs::path long_name = dir.path() / std::string(300, 'x');  // NAME_MAX is 255 on Linux
+  message = mesh_error_message([&] { read_obj(long_name); });
+  EXPECT_EQ(message.find("no such file"), std::string::npos) << message;
+  EXPECT_NE(message.find(std::make_error_code(std::errc::filename_too_long).message()),
+            std::string::npos)
+      << message;
+
+  // A missing file below an existing one: the path names no file, and says why.
+  const fs::path file = dir.write("mesh.obj", "");
+  message = mesh_error_message([&] { read_obj(file / "inside.obj"); });
+  EXPECT_NE(message.find("no such file"), std::string::npos) << message;
+}
+
+// Reference: issue 11 (fuzzing): a regular file that exists but cannot be opened was reported
+// without the reason. As root, permissions do not stop a read, so a file of /proc that refuses to
+// be opened for reading stands in (/proc/sys/vm/drop_caches is write-only even for root); the
+// expected reason is what fopen itself reports for the same file.
+TEST(ObjReader, GivesTheReasonAFileCannotBeOpened) {
+  const TempDir dir;
+  fs::path file = dir.write("locked.obj", "v 0 0 0\n");
+  fs::permissions(file, fs::perms::none);
+  std::FILE* probe = std::fopen(file.c_str(), "rb");
+  if (probe != nullptr) {  // root: try the write-only kernel file
+    std::fclose(probe);
+    file = "/proc/sys/vm/drop_caches";
+    probe = fs::is_regular_file(file) ? std::fopen(file.c_str(), "rb") : nullptr;
+    if (probe != nullptr || !fs::is_regular_file(file)) {
+      if (probe != nullptr) std::fclose(probe);
+      GTEST_SKIP() << "no regular file here that cannot be opened for reading";
+    }
+  }
+  const std::string reason = std::generic_category().message(errno);
+  const std::string message = mesh_error_message([&] { read_obj(file); });
+  EXPECT_EQ(message.rfind(file.string() + ": cannot open the OBJ file", 0), 0U) << message;
+  EXPECT_NE(message.find(reason), std::string::npos) << message;
+}
+
+// Reference: issue 11 (fuzzing): a read error (here /proc/self/mem, which opens but fails to read
+// at offset 0 with EIO) escaped read_obj as std::ios_base::failure, without the file name. It
+// must be a MeshError naming the file and the reason.
+TEST(ObjReader, ReportsAReadErrorAsAMeshErrorNamingTheFile) {
+  const fs::path file = "/proc/self/mem";
+  if (!fs::is_regular_file(file)) GTEST_SKIP() << file << " is not available";
+  std::string message;
+  try {
+    read_obj(file);
+    ADD_FAILURE() << "reading " << file << " should fail";
+  } catch (const MeshError& error) {
+    message = error.what();
+  } catch (const std::exception& error) {
+    ADD_FAILURE() << "expected a grbd::body::MeshError, got: " << error.what();
+  }
+  EXPECT_EQ(message.rfind(file.string() + ": cannot read the OBJ file: read error", 0), 0U)
+      << message;
+  EXPECT_NE(message.find(std::make_error_code(std::errc::io_error).message()), std::string::npos)
+      << message;
+}
+
+// Reference: issue 11 (fuzzing): opening a FIFO for reading blocks until a writer comes, so a
+// FIFO must be refused from its type without being opened (this test would hang otherwise).
+TEST(ObjReader, RefusesAFifoWithoutOpeningIt) {
+  const TempDir dir;
+  const fs::path fifo = dir.path() / "pipe.obj";
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0) << std::generic_category().message(errno);
+  const std::string message = mesh_error_message([&] { read_obj(fifo); });
+  EXPECT_EQ(message.rfind(fifo.string() + ": ", 0), 0U) << message;
+  EXPECT_NE(message.find("not a regular file"), std::string::npos) << message;
+  EXPECT_NE(message.find("FIFO"), std::string::npos) << message;
+}
+
+// Reference: issue 11 (fuzzing) and IEEE 754 rounding: 1e-400 lies below half the smallest
+// subnormal double, so its correctly rounded value is ±0 (what strtod returns too); it was
+// refused as "not a finite decimal number". A coordinate that underflows is read as ±0. A
+// number that overflows is refused as such, with the largest double in the message.
+TEST(ObjReader, ReadsUnderflowingCoordinatesAsZeroAndNamesOverflow) {
+  const TempDir dir;
+  const std::string faces = "f 1 2 3\n";
+  const fs::path tiny = dir.write(
+      "tiny.obj",
+      "v 1e-400 -1e-400 0.0000000001e-390\nv 1 0 2e-324\nv 0 1 -1e-99999999999\n" + faces);
+  const TriangleMesh mesh = read_obj(tiny);
+  ASSERT_EQ(mesh.V.rows(), 3);
+  EXPECT_EQ(mesh.V(0, 0), 0.0);
+  EXPECT_FALSE(std::signbit(mesh.V(0, 0)));
+  EXPECT_EQ(mesh.V(0, 1), 0.0);
+  EXPECT_TRUE(std::signbit(mesh.V(0, 1)));  // −1e-400 rounds to −0
+  EXPECT_EQ(mesh.V(0, 2), 0.0);
+  EXPECT_EQ(mesh.V(1, 2), 0.0);
+  EXPECT_EQ(mesh.V(2, 2), 0.0);
+  EXPECT_TRUE(std::signbit(mesh.V(2, 2)));
+
+  for (const std::string huge : {"1e999", "-1e309", "123456789e99999999999999", "0.1e310"}) {
+    const fs::path file = dir.write("huge.obj", "v 0 0 0\nv 1 " + huge + " 0\n" + faces);
+    const std::string message = mesh_error_message([&] { read_obj(file); });
+    EXPECT_EQ(message.rfind(file.string() + ":2: expected ", 0), 0U) << message;
+    EXPECT_NE(message.find("found '" + huge + "', which overflows"), std::string::npos) << message;
+    EXPECT_NE(message.find("1.7976931348623157e+308"), std::string::npos) << message;
+  }
+}
+
+// Reference: issue 11 (fuzzing): a face index beyond the range of int (2147483648 = 2³¹) is an
+// integer out of range and must get the range message, not the generic form message.
+TEST(ObjReader, CallsAFaceIndexBeyondTheIntRangeOutOfRange) {
+  const TempDir dir;
+  const std::string tetra = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\n";
+  for (const std::string index :
+       {"2147483648", "-2147483649", "4294967297", "99999999999999999999999", "2147483648/1"}) {
+    const fs::path file = dir.write("big_index.obj", tetra + "f 1 2 " + index + "\n");
+    const std::string message = mesh_error_message([&] { read_obj(file); });
+    EXPECT_EQ(message, file.string() + ":5: expected a vertex index in [1, 4] or [-4, -1], " +
+                           "found '" + index + "'");
+  }
+  // Texture and normal indices are checked as non-zero integers but not used: a large one is
+  // an integer all the same.
+  const fs::path file = dir.write("big_texture.obj", tetra + "f 1/4294967297 3 2\n");
+  EXPECT_EQ(read_obj(file).F.rows(), 1);
+}
+
+// Reference: issue 11 (fuzzing): the vertices (±1e308, ±1e308, ±1e308) form a regular
+// tetrahedron whose signed volume a·(b × c)/6 ≈ 1e924 overflows; it was reported as "expected
+// outward-oriented faces … signed volume -nan". The overflow must be named as such, with the
+// file and the largest coordinate magnitude.
+TEST(MeshTopology, NamesCoordinatesSoLargeThatTheVolumeOverflows) {
+  const TempDir dir;
+  const fs::path file = dir.write("huge.obj",
+                                  "v 1e308 1e308 1e308\nv -1e308 -1e308 1e308\n"
+                                  "v 1e308 -1e308 -1e308\nv -1e308 1e308 -1e308\n"
+                                  "f 1 2 3\nf 1 3 4\nf 1 4 2\nf 2 4 3\n");
+  const TriangleMesh mesh = read_obj(file);
+  const std::string message = rejection_message(mesh, file);
+  EXPECT_NE(message.find("coordinates too large"), std::string::npos) << message;
+  EXPECT_NE(message.find("overflow"), std::string::npos) << message;
+  EXPECT_NE(message.find("1e+308"), std::string::npos) << message;
+  EXPECT_EQ(message.find("nan"), std::string::npos) << message;
+  EXPECT_EQ(message.find("outward"), std::string::npos) << message;
+
+  // Scaled down to 1e100 the volume (≈ 1e300) is finite and the mesh passes.
+  TriangleMesh scaled = mesh;
+  scaled.V *= 1e-208;
+  EXPECT_NO_THROW(require_closed_oriented(scaled, "scaled"));
 }
 
 // Reference: the contract of read_obj on any input: it returns a mesh whose face indices are in

@@ -1,6 +1,6 @@
 // Chapter 5: the FCLIB reader and the local problem ξ = W λ + q — reading the three FCLIB files of
-// chapters/05-contact-laws/data, the three sparse storage kinds, the refusal of malformed files, the
-// block-sparse Delassus matrix and the conversion of a global problem to local form.
+// chapters/05-contact-laws/data, the three sparse storage kinds, the refusal of malformed files,
+// the block-sparse Delassus matrix and the conversion of a global problem to local form.
 //
 // Independent references: the file contents as listed by a separate program on HDF5's own
 // H5Ovisit/H5Dread (contact counts 60, 286, 356 also in the README; titles, storage kinds, first
@@ -12,24 +12,35 @@
 #include <gtest/gtest.h>
 #include <hdf5.h>
 
+#include <sys/stat.h>
+#include <unistd.h>
 #include <Eigen/Dense>
 #include <Eigen/SparseCore>
+
 #include <algorithm>
 #include <atomic>
+#include <cerrno>
+#include <chrono>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <future>
 #include <limits>
 #include <random>
 #include <set>
 #include <string>
+#include <system_error>
 #include <typeinfo>
+#include <utility>
 #include <vector>
 
 #include "grbd/contact/fclib.hpp"
 #include "grbd/contact/local_problem.hpp"
+#include "grbd/core/checks.hpp"
 #include "grbd/core/error.hpp"
 #include "grbd_test/random.hpp"
 
@@ -52,7 +63,6 @@ constexpr const char* kSpheres = "Spheres-i099-356-679.hdf5";
 // Helpers: data files, temporary folders, messages.
 
 fs::path data_file(const char* name) { return fs::path(GRBD_FCLIB_DATA_DIR) / name; }
-
 
 // A fresh folder under the system's temporary folder, removed with everything in it.
 class TempDir {
@@ -121,8 +131,10 @@ class H5 {
   ~H5() {
     if (id_ >= 0) close_(id_);
   }
+  H5(H5&& other) noexcept : id_(std::exchange(other.id_, H5I_INVALID_HID)), close_(other.close_) {}
   H5(const H5&) = delete;
   H5& operator=(const H5&) = delete;
+  H5& operator=(H5&&) = delete;
   hid_t get() const { return id_; }
 
  private:
@@ -582,11 +594,11 @@ TEST(FclibReader, MalformedDatasetsAreRefusedByName) {
         contains(local_error(path), {path.string(), "/fclib_local/vectors/q has 179 entries",
                                      "3n = 180", "/fclib_local/vectors/mu"}));
   }
-  {  // mu one entry longer: q no longer has 3n entries.
+  {  // mu one entry longer: n comes from W (180 × 180 = 3n × 3n), and mu must have n entries.
     const fs::path path = copy(kPerioBox);
     replace_reals(path, "/fclib_local/vectors/mu", std::vector<double>(61, 0.5));
-    EXPECT_TRUE(
-        contains(local_error(path), {"/fclib_local/vectors/q has 180 entries", "3n = 183"}));
+    EXPECT_TRUE(contains(local_error(path), {"/fclib_local/vectors/mu has 61 entries", "n = 60",
+                                             "/fclib_local/W is 180 × 180"}));
   }
   {  // A negative friction coefficient, a NaN in q.
     const fs::path path = copy(kPerioBox);
@@ -627,7 +639,8 @@ TEST(FclibReader, MalformedDatasetsAreRefusedByName) {
   {  // W of the wrong shape; an integer header stored as floating point.
     const fs::path path = copy(kPerioBox);
     replace_integers(path, "/fclib_local/W/m", {177});
-    EXPECT_TRUE(contains(local_error(path), {"matrix /fclib_local/W is 177 × 180", "180 × 180"}));
+    EXPECT_TRUE(
+        contains(local_error(path), {"matrix /fclib_local/W is 177 × 180", "square 3n × 3n"}));
     replace_reals(path, "/fclib_local/W/m", {180.0});
     EXPECT_TRUE(contains(local_error(path),
                          {"/fclib_local/W/m holds floating-point data", "expected integer data"}));
@@ -793,6 +806,548 @@ TEST(FclibReader, ReadsALocalProblemWrittenByTheTest) {
   write_local_file(flat_path, W, q, mu, 2);
   EXPECT_TRUE(contains(error_message([&] { grbd::contact::read_fclib_local(flat_path); }),
                        {flat_path.string() + ": ", "/fclib_local/spacedim is 2", "3D"}));
+}
+
+// ---------------------------------------------------------------------------------------------
+// FclibReader: hostile files (issue 11, /work/shared/data/bad-inputs/README.md). Each case is
+// built here with the HDF5 C API; each must be refused with a grbd::Error naming the file and the
+// dataset, at once (well under a second), and never block.
+
+// Runs `f` and returns what it returns (or throws what it throws), but aborts the whole test
+// program with a message if `f` has not finished after `limit`: a reader that blocks, on a FIFO
+// for instance, must fail the tests rather than hang them.
+template <class F>
+auto within(std::chrono::seconds limit, const std::string& what, F&& f) {
+  auto future = std::async(std::launch::async, std::forward<F>(f));
+  if (future.wait_for(limit) != std::future_status::ready) {
+    std::fprintf(stderr, "FATAL: %s has not finished after %lld s: the FCLIB reader blocks\n",
+                 what.c_str(), static_cast<long long>(limit.count()));
+    std::fflush(stderr);
+    std::abort();
+  }
+  return future.get();
+}
+
+// The message of the grbd::Error that `read` throws (a failure if none or another), which must
+// come within `limit` seconds; the reader runs under a watchdog of 20 s.
+template <class E = grbd::Error>
+std::string prompt_refusal(const std::string& what, const std::function<void()>& read,
+                           double limit = 1.0) {
+  const auto start = std::chrono::steady_clock::now();
+  const std::string message =
+      error_message<E>([&] { within(std::chrono::seconds(20), what, read); });
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  EXPECT_LT(seconds, limit) << what << " took " << seconds << " s to be refused";
+  return message;
+}
+
+// Each reader that opens `/fclib_local/vectors/mu` or the whole file, as a list of (name, call).
+std::vector<std::pair<std::string, std::function<void()>>> all_readers(const fs::path& path) {
+  return {{"read_fclib_info", [path] { grbd::contact::read_fclib_info(path); }},
+          {"read_fclib_local", [path] { grbd::contact::read_fclib_local(path); }},
+          {"read_fclib_as_local", [path] { grbd::contact::read_fclib_as_local(path); }}};
+}
+
+// A valid local problem of 2 contacts with W stored as triplets.
+void write_two_contacts(const fs::path& path) {
+  Eigen::MatrixXd W = 2.0 * Eigen::MatrixXd::Identity(6, 6);
+  W(0, 3) = W(3, 0) = 0.5;
+  write_local_file(path, W.sparseView(), {-1, 0.1, 0, -0.5, 0, 0.2}, {0.3, 0.6});
+}
+
+// Replaces dataset `name` of the file at `path` by one of `count` entries (a scalar if count is
+// 0 and `scalar`) of type `type`, made with the creation property list `dcpl`, into which nothing
+// is written: its size is declared, not stored.
+void replace_with_declared(const fs::path& path, const std::string& name, hid_t type, hsize_t count,
+                           hid_t dcpl = H5P_DEFAULT, bool scalar = false) {
+  const H5 file = open_file(path);
+  ASSERT_GE(file.get(), 0);
+  if (H5Lexists(file.get(), name.c_str(), H5P_DEFAULT) > 0) {
+    ASSERT_GE(H5Ldelete(file.get(), name.c_str(), H5P_DEFAULT), 0) << name;
+  }
+  const hsize_t unlimited = H5S_UNLIMITED;
+  const H5 space(scalar ? H5Screate(H5S_SCALAR)
+                        : H5Screate_simple(1, &count, dcpl == H5P_DEFAULT ? nullptr : &unlimited),
+                 H5Sclose);
+  const H5 dataset(
+      H5Dcreate2(file.get(), name.c_str(), type, space.get(), H5P_DEFAULT, dcpl, H5P_DEFAULT),
+      H5Dclose);
+  ASSERT_GE(dataset.get(), 0) << name;
+}
+
+// A creation property list for chunks of `chunk` entries, compressed with deflate if `deflate`.
+H5 chunked(hsize_t chunk, bool deflate = false) {
+  H5 dcpl(H5Pcreate(H5P_DATASET_CREATE), H5Pclose);
+  EXPECT_GE(H5Pset_chunk(dcpl.get(), 1, &chunk), 0);
+  if (deflate) {
+    EXPECT_GE(H5Pset_deflate(dcpl.get(), 6), 0);
+  }
+  return dcpl;
+}
+
+TEST(FclibReader, AFifoIsRefusedWithoutBlocking) {
+  // Issue 11: a FIFO given as the file name blocked the reader forever (H5Fis_hdf5 opens it and
+  // waits for a writer). Refused by its file type before HDF5 sees it.
+  TempDir dir;
+  const fs::path fifo = dir / "problem.hdf5";
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  const fs::path link = dir / "link.hdf5";
+  fs::create_symlink(fifo, link);
+  for (const fs::path& path : {fifo, link}) {
+    auto readers = all_readers(path);
+    readers.emplace_back("read_fclib_matrix",
+                         [path] { grbd::contact::read_fclib_matrix(path, "/fclib_local/W"); });
+    readers.emplace_back("read_fclib_global", [path] { grbd::contact::read_fclib_global(path); });
+    for (const auto& [name, read] : readers) {
+      SCOPED_TRACE(name + " of " + path.string());
+      EXPECT_TRUE(contains(prompt_refusal(name + " of a FIFO", read),
+                           {path.string() + ": ", "is a FIFO", "not a regular file"}));
+    }
+  }
+}
+
+TEST(FclibReader, ExistingButUnreadablePathsAreNotCalledMissing) {
+  // Issue 11: every path that could not be examined was "no such file", its error code ignored.
+  TempDir dir;
+  const auto refusal = [](const fs::path& path) {
+    return prompt_refusal("read_fclib_info of " + path.string(),
+                          [path] { grbd::contact::read_fclib_info(path); });
+  };
+  const fs::path absent = dir / "absent.hdf5";
+  EXPECT_TRUE(contains(refusal(absent), {absent.string() + ": ", "no such file"}));
+  const fs::path folder = dir / "folder.hdf5";
+  fs::create_directory(folder);
+  EXPECT_TRUE(contains(refusal(folder), {folder.string() + ": ", "is a directory"}));
+  // A symbolic link to itself exists but cannot be resolved (ELOOP).
+  const fs::path loop = dir / "loop.hdf5";
+  fs::create_symlink(loop, loop);
+  const std::string loop_message = refusal(loop);
+  EXPECT_TRUE(contains(loop_message, {loop.string() + ": ", "cannot be accessed",
+                                      std::generic_category().message(ELOOP)}));
+  EXPECT_EQ(loop_message.find("no such file"), std::string::npos) << loop_message;
+  // A file without read permission (not testable as root, who reads it anyway).
+  const fs::path locked = dir / "locked.hdf5";
+  write_two_contacts(locked);
+  fs::permissions(locked, fs::perms::none);
+  if (::access(locked.c_str(), R_OK) != 0) {
+    EXPECT_TRUE(contains(refusal(locked), {locked.string() + ": ", "cannot be opened",
+                                           std::generic_category().message(EACCES)}));
+  }
+  fs::permissions(locked, fs::perms::owner_read | fs::perms::owner_write);
+  EXPECT_EQ(grbd::contact::read_fclib_local(locked).mu.size(), 2U);
+}
+
+TEST(FclibReader, LinksOutOfTheFileAreNotFollowed) {
+  // Issue 11: /fclib_local/vectors/mu as an external link to a FIFO blocked the reader forever
+  // (HDF5 follows the link and opens the FIFO). No soft or external link is followed, and no
+  // dataset whose data lie in another file (external storage, virtual dataset) is read.
+  TempDir dir;
+  const fs::path fifo = dir / "pipe";
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  const fs::path valid = dir / "valid.hdf5";
+  write_two_contacts(valid);
+  ASSERT_EQ(grbd::contact::read_fclib_local(valid).mu.size(), 2U);
+  int count = 0;
+  const auto variant = [&](const std::function<void(hid_t)>& edit) {
+    const fs::path path = dir / ("variant-" + std::to_string(count++) + ".hdf5");
+    fs::copy_file(valid, path);
+    const H5 file = open_file(path);
+    EXPECT_GE(file.get(), 0);
+    edit(file.get());
+    return path;
+  };
+  const auto relink = [&](const std::string& object, const std::function<void(hid_t)>& link) {
+    return variant([&](hid_t file) {
+      ASSERT_GE(H5Ldelete(file, object.c_str(), H5P_DEFAULT), 0) << object;
+      link(file);
+    });
+  };
+  const auto external = [&](const std::string& object, const fs::path& target,
+                            const std::string& target_object) {
+    return relink(object, [&](hid_t file) {
+      ASSERT_GE(H5Lcreate_external(target.c_str(), target_object.c_str(), file, object.c_str(),
+                                   H5P_DEFAULT, H5P_DEFAULT),
+                0);
+    });
+  };
+  const std::string mu = "/fclib_local/vectors/mu";
+  struct Case {
+    std::string what;
+    fs::path path;
+    std::vector<std::string> expected;
+  };
+  std::vector<Case> cases = {
+      {"mu as an external link to a FIFO",
+       external(mu, fifo, "/x"),
+       {mu + " is an external link", fifo.string()}},
+      {"mu as an external link to a valid file",
+       external(mu, valid, mu),
+       {mu + " is an external link", valid.string()}},
+      {"mu as a soft link",
+       relink(mu,
+              [&](hid_t file) {
+                ASSERT_GE(H5Lcreate_soft("/fclib_local/vectors/q", file, mu.c_str(), H5P_DEFAULT,
+                                         H5P_DEFAULT),
+                          0);
+              }),
+       {mu + " is a soft link to /fclib_local/vectors/q"}},
+      {"the group /fclib_local as an external link",
+       external("/fclib_local", fifo, "/x"),
+       {"/fclib_local is an external link"}},
+      {"the group W as an external link",
+       external("/fclib_local/W", fifo, "/W"),
+       {"/fclib_local/W is an external link"}},
+      {"mu with its data in an external file (a FIFO)",
+       variant([&](hid_t) {}),  // rewritten below, once the file is closed
+       {mu, "external file"}},
+      {"mu as a virtual dataset of a FIFO", variant([&](hid_t) {}), {mu, "virtual dataset"}},
+  };
+  {  // mu stored in an external file, the FIFO.
+    const H5 dcpl(H5Pcreate(H5P_DATASET_CREATE), H5Pclose);
+    ASSERT_GE(H5Pset_external(dcpl.get(), fifo.c_str(), 0, 16), 0);
+    const hsize_t two = 2;
+    const H5 file = open_file(cases[5].path);
+    ASSERT_GE(H5Ldelete(file.get(), mu.c_str(), H5P_DEFAULT), 0);
+    const H5 space(H5Screate_simple(1, &two, nullptr), H5Sclose);
+    const H5 dataset(H5Dcreate2(file.get(), mu.c_str(), H5T_IEEE_F64LE, space.get(), H5P_DEFAULT,
+                                dcpl.get(), H5P_DEFAULT),
+                     H5Dclose);
+    ASSERT_GE(dataset.get(), 0);
+  }
+  {  // mu as a virtual dataset mapping /x of the FIFO.
+    const hsize_t two = 2;
+    const H5 space(H5Screate_simple(1, &two, nullptr), H5Sclose);
+    const H5 dcpl(H5Pcreate(H5P_DATASET_CREATE), H5Pclose);
+    ASSERT_GE(H5Pset_virtual(dcpl.get(), space.get(), fifo.c_str(), "/x", space.get()), 0);
+    const H5 file = open_file(cases[6].path);
+    ASSERT_GE(H5Ldelete(file.get(), mu.c_str(), H5P_DEFAULT), 0);
+    const H5 dataset(H5Dcreate2(file.get(), mu.c_str(), H5T_IEEE_F64LE, space.get(), H5P_DEFAULT,
+                                dcpl.get(), H5P_DEFAULT),
+                     H5Dclose);
+    ASSERT_GE(dataset.get(), 0);
+  }
+  // Optional objects are not skipped when they are links: the info's title, the R of equality
+  // constraints (whose presence is tested).
+  cases.push_back({"the title as an external link",
+                   variant([&](hid_t file) {
+                     make_group(file, "/fclib_local/info");
+                     ASSERT_GE(
+                         H5Lcreate_external(fifo.c_str(), "/t", file, "/fclib_local/info/title",
+                                            H5P_DEFAULT, H5P_DEFAULT),
+                         0);
+                   }),
+                   {"/fclib_local/info/title is an external link"}});
+  cases.push_back({"R as an external link",
+                   variant([&](hid_t file) {
+                     ASSERT_GE(H5Lcreate_external(fifo.c_str(), "/R", file, "/fclib_local/R",
+                                                  H5P_DEFAULT, H5P_DEFAULT),
+                               0);
+                   }),
+                   {"/fclib_local/R is an external link"}});
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.what);
+    for (const auto& [name, read] : all_readers(c.path)) {
+      if (c.what == "the title as an external link" && name != "read_fclib_info") continue;
+      SCOPED_TRACE(name);
+      std::vector<std::string> expected = c.expected;
+      expected.push_back(c.path.string() + ": ");
+      const std::string message = prompt_refusal(name + " of " + c.what, read);
+      for (const std::string& part : expected) {
+        EXPECT_TRUE(contains(message, {part}));
+      }
+    }
+  }
+  EXPECT_EQ(open_hdf5_objects(), 0) << "a refused file left HDF5 objects open";
+}
+
+TEST(FclibReader, DeclaredSizesAreCheckedBeforeAnythingIsAllocated) {
+  // Issue 11: tiny files declaring huge sizes took 9-25 s and gigabytes, or ended in
+  // std::bad_alloc. Each size is checked against the element type, the file's size and the other
+  // declared sizes before anything is allocated, and refused in well under a second.
+  TempDir dir;
+  int count = 0;
+  const auto variant = [&] {
+    const fs::path path = dir / ("declared-" + std::to_string(count++) + ".hdf5");
+    write_two_contacts(path);
+    return path;
+  };
+  struct Case {
+    std::string what;
+    fs::path path;
+    std::vector<std::string> expected;
+    bool info_only = false;     // the dataset is read by read_fclib_info only
+    bool problem_only = false;  // the dataset is not read by read_fclib_info
+  };
+  std::vector<Case> cases;
+  {  // mu declared with 2e8 entries, chunked, none written (local_csr_mu_declared_2e8.hdf5).
+    const fs::path path = variant();
+    replace_with_declared(path, "/fclib_local/vectors/mu", H5T_IEEE_F64LE, 200000000,
+                          chunked(1024).get());
+    cases.push_back({"mu declared with 2e8 entries",
+                     path,
+                     {"dataset /fclib_local/vectors/mu has 200000000 entries", "expected n = 2",
+                      "/fclib_local/W is 6 × 6"}});
+  }
+  {  // The same, compressed: the declared sizes still disagree.
+    const fs::path path = variant();
+    replace_with_declared(path, "/fclib_local/vectors/mu", H5T_IEEE_F64LE, 200000000,
+                          chunked(1024, true).get());
+    cases.push_back({"mu declared with 2e8 compressed entries",
+                     path,
+                     {"dataset /fclib_local/vectors/mu has 200000000 entries", "expected n = 2"}});
+  }
+  {  // A fixed-length title of 2 GiB (local_csr_title_2GiB.hdf5).
+    const fs::path path = variant();
+    const H5 type(H5Tcopy(H5T_C_S1), H5Tclose);
+    ASSERT_GE(H5Tset_size(type.get(), std::size_t{1} << 31), 0);
+    {
+      const H5 file = open_file(path);
+      make_group(file.get(), "/fclib_local/info");
+    }
+    replace_with_declared(path, "/fclib_local/info/title", type.get(), 0, H5P_DEFAULT, true);
+    cases.push_back({"a title of 2 GiB",
+                     path,
+                     {"dataset /fclib_local/info/title", "string of 2147483648 bytes"},
+                     true});
+  }
+  // Datatype sizes of gigabytes (fclib_{mu,guess,spacedim}_type_size_corrupt.hdf5).
+  for (const auto& [object, integer] :
+       std::vector<std::pair<std::string, bool>>{{"/fclib_local/vectors/mu", false},
+                                                 {"/guesses/1/r", false},
+                                                 {"/fclib_local/spacedim", true}}) {
+    const fs::path path = variant();
+    const H5 type(H5Tcopy(integer ? H5T_STD_I32LE : H5T_IEEE_F64LE), H5Tclose);
+    ASSERT_GE(H5Tset_size(type.get(), 3372220424U), 0);
+    if (object == "/guesses/1/r") {
+      const H5 file = open_file(path);
+      make_group(file.get(), "/guesses");
+      make_group(file.get(), "/guesses/1");
+    }
+    replace_with_declared(path, object, type.get(), object == "/guesses/1/r" ? 6 : 2);
+    cases.push_back(
+        {object + " of 3372220424-byte elements",
+         path,
+         {"dataset " + object,
+          std::string(integer ? "integers" : "floating-point numbers") + " of 3372220424 bytes"},
+         object == "/guesses/1/r"});
+  }
+  {  // W declared with 2^31 - 1 triplets (local_csr_W_declared_2pow31.hdf5): nz > nzmax.
+    const fs::path path = variant();
+    replace_integers(path, "/fclib_local/W/nz", {2147483647});
+    cases.push_back(
+        {"nz = 2^31 - 1 with nzmax = 8",
+         path,
+         {"dataset /fclib_local/W/nz declares 2147483647 triplets", "more than nzmax = 8"}});
+  }
+  {  // The same with nzmax = nz and p, i, x declared with 2^31 - 1 entries, none stored.
+    const fs::path path = variant();
+    replace_integers(path, "/fclib_local/W/nz", {2147483647});
+    replace_integers(path, "/fclib_local/W/nzmax", {2147483647});
+    for (const char* name : {"/fclib_local/W/i", "/fclib_local/W/p", "/fclib_local/W/x"}) {
+      replace_with_declared(path, name, name[13] == 'x' ? H5T_IEEE_F64LE : H5T_STD_I32LE,
+                            2147483647, chunked(4096).get());
+    }
+    cases.push_back({"p, i, x declared with 2^31 - 1 entries",
+                     path,
+                     {"dataset /fclib_local/W/i declares 2147483647 entries of 4 bytes",
+                      "more than the", "bytes of the whole file"},
+                     false,
+                     true});
+  }
+  {  // n = 2^31 - 1 (local_csr_n_2pow31.hdf5).
+    const fs::path path = variant();
+    replace_integers(path, "/fclib_local/W/n", {2147483647});
+    cases.push_back({"W with n = 2^31 - 1",
+                     path,
+                     {"matrix /fclib_local/W is 6 × 2147483647", "square 3n × 3n"}});
+  }
+  {  // Chunks of 2^25 doubles (256 MiB) for 2 entries.
+    const fs::path path = variant();
+    replace_with_declared(path, "/fclib_local/vectors/mu", H5T_IEEE_F64LE, 2,
+                          chunked(hsize_t{1} << 25).get());
+    cases.push_back({"mu in chunks of 256 MiB",
+                     path,
+                     {"dataset /fclib_local/vectors/mu is stored in chunks of 268435456 bytes"}});
+  }
+  {  // mu declared contiguous and never written.
+    const fs::path path = variant();
+    replace_with_declared(path, "/fclib_local/vectors/mu", H5T_IEEE_F64LE, 2);
+    cases.push_back(
+        {"mu never written", path, {"dataset /fclib_local/vectors/mu", "stores none of them"}});
+  }
+  {  // A non-IEEE float (x87 long double, 16 bytes) and a non-standard integer.
+    const fs::path path = variant();
+    replace_with_declared(path, "/fclib_local/vectors/q", H5T_NATIVE_LDOUBLE, 6);
+    cases.push_back({"q of long doubles",
+                     path,
+                     {"dataset /fclib_local/vectors/q holds floating-point numbers of " +
+                      std::to_string(H5Tget_size(H5T_NATIVE_LDOUBLE)) + " bytes"},
+                     false,
+                     true});
+    const fs::path other = variant();
+    const H5 type(H5Tcopy(H5T_STD_I32LE), H5Tclose);
+    ASSERT_GE(H5Tset_precision(type.get(), 20), 0);
+    replace_with_declared(other, "/fclib_local/spacedim", type.get(), 1);
+    cases.push_back({"spacedim of 20-bit integers",
+                     other,
+                     {"dataset /fclib_local/spacedim holds integers of 4 bytes",
+                      "non-standard layout (precision 20 bits"}});
+  }
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.what);
+    for (const auto& [name, read] : all_readers(c.path)) {
+      if (c.info_only && name != "read_fclib_info") continue;
+      if (c.problem_only && name == "read_fclib_info") continue;
+      SCOPED_TRACE(name);
+      const std::string message = prompt_refusal(name + " of " + c.what, read);
+      EXPECT_TRUE(contains(message, {c.path.string() + ": "}));
+      for (const std::string& part : c.expected) EXPECT_TRUE(contains(message, {part}));
+    }
+  }
+  {  // A global problem with M declared 2^31 - 1 × 2^31 - 1 (no entries): f must have m entries.
+    const fs::path path = dir / "global-huge-m.hdf5";
+    {
+      const H5 file = create_file(path);
+      make_group(file.get(), "/fclib_global");
+      write_integers(file.get(), "/fclib_global/spacedim", {3});
+      write_matrix(file.get(), "/fclib_global/M", stored(2147483647, 2147483647, 0, 0, {}, {}, {}));
+      write_matrix(file.get(), "/fclib_global/H", stored(2147483647, 3, 0, 0, {}, {}, {}));
+      make_group(file.get(), "/fclib_global/vectors");
+      write_reals(file.get(), "/fclib_global/vectors/f", {1, 2});
+      write_reals(file.get(), "/fclib_global/vectors/w", {0, 0, 0});
+      write_reals(file.get(), "/fclib_global/vectors/mu", {0.5});
+    }
+    for (const auto& read :
+         std::vector<std::function<void()>>{[&] { grbd::contact::read_fclib_global(path); },
+                                            [&] { grbd::contact::read_fclib_as_local(path); }}) {
+      EXPECT_TRUE(contains(prompt_refusal("read of a global problem with m = 2^31 - 1", read),
+                           {path.string() + ": ", "dataset /fclib_global/vectors/f has 2 entries",
+                            "expected m = 2147483647"}));
+    }
+    // A matrix read on its own: its dimensions cannot exceed the file's size.
+    EXPECT_TRUE(contains(
+        prompt_refusal("read_fclib_matrix of M",
+                       [&] { grbd::contact::read_fclib_matrix(path, "/fclib_global/M"); }),
+        {path.string() + ": ", "matrix /fclib_global/M declares", "larger than the file's"}));
+  }
+  EXPECT_EQ(open_hdf5_objects(), 0) << "a refused file left HDF5 objects open";
+}
+
+TEST(FclibReader, CompressedAndChunkedDataAreRead) {
+  // The size checks refuse no honest storage: chunked and deflated datasets whose data, inflated,
+  // exceed the file read as the same problem.
+  TempDir dir;
+  const fs::path plain = dir / "plain.hdf5";
+  write_two_contacts(plain);
+  const fs::path packed = dir / "packed.hdf5";
+  {
+    const H5 file = create_file(packed);
+    make_group(file.get(), "/fclib_local");
+    write_integers(file.get(), "/fclib_local/spacedim", {3});
+    // W: 3000 × 3000, the identity times 2 as 3000 triplets, all deflated.
+    constexpr int n = 1000;
+    std::vector<std::int64_t> index(3 * n);
+    for (int k = 0; k < 3 * n; ++k) index[static_cast<std::size_t>(k)] = k;
+    make_group(file.get(), "/fclib_local/W");
+    for (const auto& [name, value] : std::vector<std::pair<std::string, std::int64_t>>{
+             {"m", 3 * n}, {"n", 3 * n}, {"nz", 3 * n}, {"nzmax", 3 * n}}) {
+      write_integers(file.get(), "/fclib_local/W/" + name, {value});
+    }
+    const auto packed_dataset = [&](const std::string& name, hid_t type, hid_t memory_type,
+                                    const void* data, hsize_t size) {
+      const H5 dcpl = chunked(256, true);
+      const H5 space(H5Screate_simple(1, &size, nullptr), H5Sclose);
+      const H5 dataset(H5Dcreate2(file.get(), name.c_str(), type, space.get(), H5P_DEFAULT,
+                                  dcpl.get(), H5P_DEFAULT),
+                       H5Dclose);
+      ASSERT_GE(dataset.get(), 0) << name;
+      ASSERT_GE(H5Dwrite(dataset.get(), memory_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, data), 0);
+    };
+    packed_dataset("/fclib_local/W/i", H5T_STD_I64LE, H5T_NATIVE_INT64, index.data(), 3 * n);
+    packed_dataset("/fclib_local/W/p", H5T_STD_I64LE, H5T_NATIVE_INT64, index.data(), 3 * n);
+    const std::vector<double> two(3 * n, 2.0), zero(3 * n, 0.0), mu(n, 0.5);
+    packed_dataset("/fclib_local/W/x", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, two.data(), 3 * n);
+    make_group(file.get(), "/fclib_local/vectors");
+    packed_dataset("/fclib_local/vectors/q", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, zero.data(), 3 * n);
+    packed_dataset("/fclib_local/vectors/mu", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, mu.data(), n);
+  }
+  EXPECT_EQ(grbd::contact::read_fclib_local(plain).mu.size(), 2U);
+  const LocalProblem problem = grbd::contact::read_fclib_local(packed);
+  ASSERT_EQ(problem.W.size(), 1000U);
+  EXPECT_EQ(problem.W.blocks[static_cast<std::size_t>(problem.W.diagonal[999])],
+            2.0 * Matrix3::Identity());
+  EXPECT_EQ(problem.mu, std::vector<double>(1000, 0.5));
+  EXPECT_EQ(grbd::contact::read_fclib_info(packed).contacts, 1000);
+}
+
+TEST(FclibReader, AnInvalidProblemIsRefusedNamingTheFile) {
+  // Issue 11 (local_csr_W_all_zero.hdf5): a W of zeros was accepted, and the solver said
+  // "validate: diagonal block (0, 0) of W ..." without naming the file. The reader validates.
+  TempDir dir;
+  const fs::path path = dir / "zero.hdf5";
+  {
+    const H5 file = create_file(path);
+    make_group(file.get(), "/fclib_local");
+    write_integers(file.get(), "/fclib_local/spacedim", {3});
+    // W in compressed rows: 8 stored zeros.
+    write_matrix(file.get(), "/fclib_local/W",
+                 stored(6, 6, -2, 8, {0, 2, 3, 4, 6, 7, 8}, {0, 3, 1, 2, 0, 3, 4, 5},
+                        std::vector<double>(8, 0.0)));
+    make_group(file.get(), "/fclib_local/vectors");
+    write_reals(file.get(), "/fclib_local/vectors/q", {-1, 0.1, 0, -0.5, 0, 0.2});
+    write_reals(file.get(), "/fclib_local/vectors/mu", {0.3, 0.6});
+  }
+  for (const auto& [name, read] : all_readers(path)) {
+    if (name == "read_fclib_info") continue;  // reads no matrix entries
+    SCOPED_TRACE(name);
+    EXPECT_TRUE(contains(prompt_refusal(name + " of a zero W", read),
+                         {path.string() + ": ", "matrix /fclib_local/W",
+                          "diagonal block (0, 0) of W has diagonal entry (0, 0) = 0"}));
+  }
+}
+
+// A global problem with M = diag(1, 1, 1, 5e-324, 2, 2): 5e-324 is the smallest subnormal double,
+// and M⁻¹ has 2e323 = inf on its diagonal.
+GlobalProblem denormal_mass_problem() {
+  GlobalProblem g;
+  Eigen::VectorXd d(6);
+  d << 1, 1, 1, 5e-324, 2, 2;
+  g.M = Eigen::MatrixXd(d.asDiagonal()).sparseView();
+  Eigen::MatrixXd H = Eigen::MatrixXd::Zero(6, 6);
+  H(0, 0) = 1;
+  H(0, 3) = -1;
+  for (int k = 1; k < 6; ++k) H(k, k) = 1;
+  g.H = H.sparseView();
+  g.f = (Eigen::VectorXd(6) << 0, 0, -1, 0, 0, -2).finished();
+  g.w = Eigen::VectorXd::Zero(6);
+  g.mu = {0.5, 0.5};
+  return g;
+}
+
+TEST(FclibReader, ASingularMassMatrixIsNamed) {
+  // Issue 11 (global_triplet_mass_denormal.hdf5): to_local returned q with NaN and -inf, and the
+  // solver blamed "q of contact 1". The reader names the file and /fclib_global/M.
+  TempDir dir;
+  const fs::path path = dir / "denormal.hdf5";
+  const GlobalProblem g = denormal_mass_problem();
+  {
+    const H5 file = create_file(path);
+    make_group(file.get(), "/fclib_global");
+    write_integers(file.get(), "/fclib_global/spacedim", {3});
+    write_matrix(file.get(), "/fclib_global/M", triplets_of(g.M));
+    write_matrix(file.get(), "/fclib_global/H", triplets_of(g.H));
+    make_group(file.get(), "/fclib_global/vectors");
+    write_reals(file.get(), "/fclib_global/vectors/f", {0, 0, -1, 0, 0, -2});
+    write_reals(file.get(), "/fclib_global/vectors/w", std::vector<double>(6, 0.0));
+    write_reals(file.get(), "/fclib_global/vectors/mu", {0.5, 0.5});
+  }
+  EXPECT_EQ(grbd::contact::read_fclib_global(path).M.coeff(3, 3), 5e-324);
+  EXPECT_TRUE(contains(
+      prompt_refusal<grbd::InvalidArgument>("read_fclib_as_local of a denormal M",
+                                            [&] { grbd::contact::read_fclib_as_local(path); }),
+      {path.string() + ": ", "/fclib_global/M", "numerically singular",
+       "M(3, 3) = 4.9406564584124654e-324"}));
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -1065,6 +1620,133 @@ TEST(LocalProblem, ToLocalRefusesBadInput) {
     EXPECT_TRUE(contains(refusal(g), {"non-finite entry H(2, 1) = nan"}));
   }
   EXPECT_NO_THROW(grbd::contact::to_local(good));
+}
+
+TEST(LocalProblem, ValidateRefusesNonFiniteDiagonalsAndCorruptStructures) {
+  // Issue 11: an infinite or NaN Delassus diagonal must not reach the solvers, nor a block
+  // structure that multiply() and the solvers would read out of bounds.
+  const auto refusal = [](const LocalProblem& problem) {
+    return error_message<grbd::InvalidArgument>([&] { grbd::contact::validate(problem); });
+  };
+  const double inf = std::numeric_limits<double>::infinity();
+  for (const double bad : {inf, -inf, std::numeric_limits<double>::quiet_NaN()}) {
+    LocalProblem problem = small_problem();  // 3 contacts, all 9 blocks stored
+    problem.W.blocks[static_cast<std::size_t>(problem.W.diagonal[1])](2, 2) = bad;
+    EXPECT_TRUE(contains(refusal(problem),
+                         {"validate", "W block (1, 1) entry (2, 2) is " + grbd::format_number(bad),
+                          "expected a finite number"}));
+  }
+  struct Case {
+    const char* what;
+    std::function<void(BlockSparseMatrix&)> corrupt;
+    std::vector<std::string> expected;
+  };
+  const std::vector<Case> cases = {
+      {"row_start not monotone",
+       [](BlockSparseMatrix& W) { W.row_start[1] = 7; },
+       {"W.row_start is not monotone", "row_start[1] = 7 > row_start[2] = 6"}},
+      {"row_start not from 0",
+       [](BlockSparseMatrix& W) { W.row_start[0] = 1; },
+       {"W.row_start[0] = 1, expected 0"}},
+      {"row_start past the blocks",
+       [](BlockSparseMatrix& W) { W.row_start[3] = 12; },
+       {"W.row_start[n] = 12", "9 block columns and 9 blocks"}},
+      {"a block column out of range",
+       [](BlockSparseMatrix& W) { W.column[8] = 3; },
+       {"block row 2 has block column 3 out of range [0, 3)"}},
+      {"a negative block column",
+       [](BlockSparseMatrix& W) { W.column[0] = -1; },
+       {"block row 0 has block column -1 out of range [0, 3)"}},
+      {"a diagonal index past the row",
+       [](BlockSparseMatrix& W) { W.diagonal[2] = 100; },
+       {"W.diagonal[2] = 100 is not the index of block (2, 2)"}},
+      {"a negative diagonal index",
+       [](BlockSparseMatrix& W) { W.diagonal[0] = -1; },
+       {"W.diagonal[0] = -1"}},
+      {"a block missing",
+       [](BlockSparseMatrix& W) { W.blocks.pop_back(); },
+       {"W.row_start[n] = 9 but W has 9 block columns and 8 blocks"}},
+      {"a block column too many",
+       [](BlockSparseMatrix& W) { W.column.push_back(0); },
+       {"10 block columns and 9 blocks"}},
+      {"a diagonal index missing",
+       [](BlockSparseMatrix& W) { W.diagonal.pop_back(); },
+       {"3 block rows but 2 diagonal indices"}},
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.what);
+    LocalProblem problem = small_problem();
+    ASSERT_EQ(problem.W.row_start, (std::vector<std::int64_t>{0, 3, 6, 9}));
+    c.corrupt(problem.W);
+    const std::string message = refusal(problem);
+    for (const std::string& part : c.expected) EXPECT_TRUE(contains(message, {part}));
+  }
+}
+
+TEST(LocalProblem, MultiplyRefusesOffsetsThatDisagreeWithTheBlocks) {
+  // multiply() checks in O(1) and O(n) per call what would make it read out of bounds through
+  // row_start; the block columns are left to validate() (see the header).
+  const std::vector<Vector3> x(3, Vector3::Ones());
+  std::vector<Vector3> y(3);
+  const auto refusal = [&](const BlockSparseMatrix& W) {
+    return error_message<grbd::InvalidArgument>([&] { grbd::contact::multiply(W, x, y); });
+  };
+  {
+    BlockSparseMatrix W = small_problem().W;
+    W.blocks.pop_back();
+    EXPECT_TRUE(contains(refusal(W), {"multiply", "8 blocks and 9 block columns"}));
+  }
+  {
+    BlockSparseMatrix W = small_problem().W;
+    W.row_start = {0, 9, 3, 9};
+    EXPECT_TRUE(contains(refusal(W), {"multiply", "not monotone at block row 1"}));
+  }
+  {
+    BlockSparseMatrix W = small_problem().W;
+    W.row_start[0] = -3;
+    EXPECT_TRUE(contains(refusal(W), {"multiply", "runs from -3 to 9"}));
+  }
+  BlockSparseMatrix W = small_problem().W;
+  EXPECT_NO_THROW(grbd::contact::multiply(W, x, y));
+}
+
+TEST(LocalProblem, ToLocalRefusesASingularMassAndNonFiniteResults) {
+  // Issue 11 (global_triplet_mass_denormal.hdf5): M = diag(1, 1, 1, 5e-324, 2, 2) passed the
+  // positive pivot test, and q came out with NaN and -inf. A pivot at most m ε times the largest
+  // proves cond(M) > 1/(m ε) (the pivots of an SPD matrix lie between its extreme eigenvalues).
+  const auto refusal = [](const GlobalProblem& g) {
+    return error_message<grbd::InvalidArgument>([&] { grbd::contact::to_local(g); });
+  };
+  EXPECT_TRUE(contains(refusal(denormal_mass_problem()),
+                       {"to_local", "M (6 × 6) is numerically singular",
+                        "row and column 3 of M, M(3, 3) = 4.9406564584124654e-324"}));
+  {  // Pivots 1 and 1e-17 of 3 × 3: 1e-17 < 3 ε = 6.7e-16.
+    GlobalProblem g = denormal_mass_problem();
+    Eigen::VectorXd d = Eigen::VectorXd::Ones(6);
+    d[4] = 1e-17;
+    g.M = Eigen::MatrixXd(d.asDiagonal()).sparseView();
+    EXPECT_TRUE(contains(refusal(g), {"numerically singular", "row and column 4"}));
+  }
+  {  // The test is relative: M = 1e-300 I is perfectly conditioned, and W = 1e300 Hᵀ H.
+    GlobalProblem g = denormal_mass_problem();
+    g.M = 1e-300 * Eigen::MatrixXd::Identity(6, 6).sparseView();
+    const LocalProblem local = grbd::contact::to_local(g);
+    EXPECT_NEAR(dense(local.W)(1, 1), 1e300, 1e285);
+    EXPECT_NO_THROW(grbd::contact::validate(local));
+  }
+  {  // M = I but H = 1e200: W = Hᵀ H = 1e400 overflows.
+    GlobalProblem g = denormal_mass_problem();
+    g.M = Eigen::MatrixXd::Identity(6, 6).sparseView();
+    g.H = 1e200 * Eigen::MatrixXd::Identity(6, 6).sparseView();
+    EXPECT_TRUE(contains(refusal(g), {"W = Hᵀ M⁻¹ H has a non-finite entry", "inf"}));
+  }
+  {  // W = 1e20 I is finite, but q = Hᵀ f = 1e310 overflows.
+    GlobalProblem g = denormal_mass_problem();
+    g.M = Eigen::MatrixXd::Identity(6, 6).sparseView();
+    g.H = 1e10 * Eigen::MatrixXd::Identity(6, 6).sparseView();
+    g.f = Eigen::VectorXd::Constant(6, 1e300);
+    EXPECT_TRUE(contains(refusal(g), {"q = Hᵀ M⁻¹ f + w has a non-finite entry q[0] = inf"}));
+  }
 }
 
 }  // namespace

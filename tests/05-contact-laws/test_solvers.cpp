@@ -1226,3 +1226,30 @@ TEST(SolverRobustness, IntMaxIterationsIsAcceptedAndStopsAtConvergence) {
     EXPECT_LT(result.iterations, 100000);
   }
 }
+
+// Regression: APGD with the percussion-change criterion reported "converged" after 2 iterations
+// at λ = (0.917, −0.256, −0.102), relative residual 0.07: the fixed point of one cycle with the
+// De Saxcé offset s frozen, not a solution of Coulomb's law. Reference: the closed form of one
+// sliding contact with W = I, q = (−1, 0.5, 0.2), μ = 0.3: λ_N = −q_N = 1 and
+// λ_T = −μ λ_N q_T/‖q_T‖ (‖q_T‖ = 0.539 > μ λ_N). Whatever the criterion, "converged" must
+// mean the law holds: every method under every criterion lands within 1e-5 of it.
+TEST(SolverRobustness, ConvergedMeansTheLawHoldsUnderEveryCriterion) {
+  const Vector3 q(-1.0, 0.5, 0.2);
+  const LocalProblem problem = one_contact(1.0, q, 0.3);
+  const Vector2 q_T = q.tail<2>();
+  const Vector3 expected(1.0, -0.3 * q_T(0) / q_T.norm(), -0.3 * q_T(1) / q_T.norm());
+  for (const Method& method : kMethods) {
+    for (const Criterion criterion : {Criterion::percussion_change, Criterion::velocity_change,
+                                      Criterion::natural_residual}) {
+      SCOPED_TRACE(std::string(method.name) + ", criterion " +
+                   std::to_string(static_cast<int>(criterion)));
+      SolverOptions options;
+      options.criterion = criterion;
+      std::vector<Vector3> lambda;
+      const SolverResult result = solve(method, problem, lambda, options);
+      ASSERT_TRUE(result.converged) << grbd::contact::describe(result);
+      EXPECT_LE((lambda[0] - expected).cwiseAbs().maxCoeff(), 1e-5)
+          << "lambda = " << lambda[0].transpose() << "; " << grbd::contact::describe(result);
+    }
+  }
+}

@@ -6,6 +6,7 @@
 
 #include <Eigen/Eigenvalues>  // SelfAdjointEigenSolver
 #include <Eigen/LU>           // determinant()
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 #include <string>
@@ -50,22 +51,52 @@ MassProperties mass_properties(const TriangleMesh& mesh, double density, std::st
   // from the origin the moments about the origin are dominated by m|r_S|², and Steiner's shift
   // back to S would cancel most of their digits. Θ_S does not depend on where we integrate.
   const Vector3 c = 0.5 * (mesh.V.colwise().minCoeff() + mesh.V.colwise().maxCoeff()).transpose();
-  const VolumeIntegrals integrals = volume_integrals(transformed(mesh, Matrix3::Identity(), -c));
+  const TriangleMesh centred_mesh = transformed(mesh, Matrix3::Identity(), -c);
+  const VolumeIntegrals integrals = volume_integrals(centred_mesh);
+  if (!std::isfinite(integrals.volume) || !integrals.first.allFinite() ||
+      !integrals.second.allFinite()) {
+    // require_closed_oriented() has seen a finite volume about the origin; the second moments
+    // grow with the fifth power of the size of the mesh and overflow first.
+    throw MeshError(std::string(source) +
+                    ": coordinates too large: the volume integrals ∫ x dV and ∫ x xᵀ dV overflow "
+                    "double (they are not finite) for a mesh that extends " +
+                    format_number(centred_mesh.V.cwiseAbs().maxCoeff()) +
+                    " from the centre of its bounding box; the second moments grow with the "
+                    "fifth power of the size: expected sizes below about 1e61");
+  }
   MassProperties props;
   props.volume = integrals.volume;
   props.mass = density * integrals.volume;
   props.M_r_S = c + integrals.first / integrals.volume;
   props.M_Theta_S = inertia_about_centre_of_mass(integrals, density);
+  if (!std::isfinite(props.mass) || !props.M_r_S.allFinite() || !props.M_Theta_S.allFinite()) {
+    // The integrals are finite: the density scales them past the largest double.
+    throw InvalidArgument(
+        "mass_properties (" + std::string(source) +
+        "): the mass properties overflow double for the density ρ = " + format_number(density) +
+        ": V = " + format_number(integrals.volume) + ", m = ρV = " + format_number(props.mass) +
+        ", max |Θ_S| = " + format_number(props.M_Theta_S.cwiseAbs().maxCoeff()) +
+        "; expected a density for which they are finite");
+  }
   return props;
 }
 
 // [principal axes]
 PrincipalAxes principal_axes(const Matrix3& M_Theta_S) {
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) {
+      if (!std::isfinite(M_Theta_S(i, j))) {
+        throw InvalidArgument("principal_axes: expected a finite inertia tensor, found Θ(" +
+                              std::to_string(i) + ", " + std::to_string(j) +
+                              ") = " + format_number(M_Theta_S(i, j)) + ", which is not finite");
+      }
+    }
+  }
   const double size = M_Theta_S.cwiseAbs().maxCoeff();
   const double asymmetry = (M_Theta_S - M_Theta_S.transpose()).cwiseAbs().maxCoeff();
-  if (!M_Theta_S.allFinite() || !(asymmetry <= 1e-8 * size)) {
+  if (!(asymmetry <= 1e-8 * size)) {
     throw InvalidArgument(
-        "principal_axes: expected a finite symmetric inertia tensor, found max |Θ − Θᵀ| = " +
+        "principal_axes: expected a symmetric inertia tensor, found max |Θ − Θᵀ| = " +
         format_number(asymmetry) + " for max |Θ| = " + format_number(size));
   }
   // Eigen's self-adjoint solver returns the eigenvalues in ascending order and orthonormal
@@ -76,6 +107,28 @@ PrincipalAxes principal_axes(const Matrix3& M_Theta_S) {
   }
   PrincipalAxes axes;
   axes.K_Theta = solver.eigenvalues();
+  // Θ = ∫ (|x|² I − x xᵀ) dm of any mass distribution has eᵀΘe = ∫ |x − (eᵀx) e|² dm ≥ 0 about
+  // every axis e, and Θ1 + Θ2 − Θ3 = 2 ∫ x3² dm ≥ 0 in its principal frame. A thin rod (Θ1 = 0)
+  // and a flat plate (Θ1 + Θ2 = Θ3) are the equality cases, met only up to round-off.
+  const Vector3& K = axes.K_Theta;
+  const double tolerance = kInertiaTolerance * std::max(std::abs(K[0]), std::abs(K[2]));
+  const auto moments = [&K] {
+    return "(" + format_number(K[0]) + ", " + format_number(K[1]) + ", " + format_number(K[2]) +
+           ")";
+  };
+  if (K[0] < -tolerance) {
+    throw InvalidArgument(
+        "principal_axes: expected an inertia tensor with non-negative principal moments "
+        "(Θ1 ≥ 0 up to 1e-10 relative), found the principal moments " +
+        moments());
+  }
+  if (K[0] + K[1] < K[2] - tolerance) {
+    throw InvalidArgument(
+        "principal_axes: expected principal moments that satisfy the triangle inequality "
+        "Θ1 + Θ2 ≥ Θ3 (up to 1e-10 relative; Θ1 + Θ2 − Θ3 = 2 ∫ x3² dm ≥ 0 for any body), found "
+        "the principal moments " +
+        moments());
+  }
   axes.A_MK = solver.eigenvectors();
   // Each eigenvector is defined up to its sign; flipping the third makes K right-handed, so
   // that A_MK is a rotation (det = +1) and can be turned into a quaternion.

@@ -11,10 +11,10 @@
 #include <charconv>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <fstream>
-#include <iterator>
 #include <limits>
-#include <sstream>
+#include <memory>
 #include <string>
 #include <system_error>
 #include <vector>
@@ -49,6 +49,42 @@ std::string quoted(std::string_view text) {
 }
 
 bool is_blank(char c) { return c == ' ' || c == '\t'; }
+
+/// The decimal order of magnitude of a well-formed decimal number (what std::from_chars matched:
+/// an optional '-', digits with an optional '.', an optional exponent): the exponent of its
+/// leading non-zero digit, so that 10^order ≤ |x| < 10^(order + 1); saturated far beyond the
+/// range of double. Only its sign is used, to tell an overflow from an underflow.
+std::int64_t decimal_order(std::string_view number) {
+  constexpr std::int64_t kSaturated = std::int64_t{1} << 40;
+  std::size_t i = number.starts_with('-') ? 1 : 0;
+  std::int64_t order = 0;
+  bool leading = true;    // no non-zero digit seen yet
+  bool fraction = false;  // after the '.'
+  for (; i < number.size() && number[i] != 'e' && number[i] != 'E'; ++i) {
+    if (number[i] == '.') {
+      fraction = true;
+    } else if (leading && number[i] == '0') {
+      if (fraction) --order;  // 0.001: each zero after the point lowers the order
+    } else if (leading) {
+      leading = false;
+      if (fraction) --order;  // the first non-zero digit after the point: 0.1 is 10^-1
+    } else if (!fraction) {
+      ++order;  // a further digit before the point: 12 is 10^1
+    }
+    order = std::clamp(order, -kSaturated, kSaturated);
+  }
+  if (i < number.size()) {  // the exponent
+    ++i;
+    const bool negative = i < number.size() && number[i] == '-';
+    if (i < number.size() && (number[i] == '-' || number[i] == '+')) ++i;
+    std::int64_t exponent = 0;
+    for (; i < number.size(); ++i) {
+      exponent = std::min(10 * exponent + (number[i] - '0'), kSaturated);
+    }
+    order += negative ? -exponent : exponent;
+  }
+  return order;
+}
 
 /// The whitespace-separated tokens of one line (spaces and tabs only: any other byte, a control
 /// character included, belongs to a token and is then reported as found).
@@ -139,8 +175,18 @@ class ObjParser {
       digits.remove_prefix(1);
     }
     double x = 0.0;
-    const auto [end, error] = std::from_chars(digits.data(), digits.data() + digits.size(), x);
-    if (error != std::errc() || end != digits.data() + digits.size() || !std::isfinite(x)) {
+    const char* const last = digits.data() + digits.size();
+    const auto [end, error] = std::from_chars(digits.data(), last, x);
+    if (error == std::errc::result_out_of_range && end == last) {
+      // A well-formed decimal number whose magnitude is beyond the range of double. Below the
+      // smallest subnormal its correctly rounded value is ±0 (as strtod gives it), a harmless
+      // coordinate; above the largest double there is no value to give.
+      if (decimal_order(digits) < 0) return digits[0] == '-' ? -0.0 : 0.0;
+      fail("a decimal number of magnitude at most " +
+               format_number(std::numeric_limits<double>::max()) + " (the largest double)",
+           quoted(token) + ", which overflows", /*quote=*/false);
+    }
+    if (error != std::errc() || end != last || !std::isfinite(x)) {
       fail("a finite decimal number", token);
     }
     return x;
@@ -157,11 +203,15 @@ class ObjParser {
     vertices_.push_back(x);
   }
 
-  /// An optional texture or normal index of a vertex reference: checked, not used.
+  /// An optional texture or normal index of a vertex reference: checked, not used, so any
+  /// non-zero integer will do, even one beyond the range of int.
   void attribute_index(std::string_view part, std::string_view token) const {
-    int value = 0;
-    const auto [end, error] = std::from_chars(part.data(), part.data() + part.size(), value);
-    if (error != std::errc() || end != part.data() + part.size() || value == 0) {
+    std::int64_t value = 0;
+    const char* const last = part.data() + part.size();
+    const auto [end, error] = std::from_chars(part.data(), last, value);
+    const bool integer =
+        end == last && (error == std::errc() || error == std::errc::result_out_of_range);
+    if (!integer || (error == std::errc() && value == 0)) {
       fail("a vertex reference 'i', 'i/t', 'i//n' or 'i/t/n' with non-zero integers", token);
     }
   }
@@ -183,13 +233,18 @@ class ObjParser {
         attribute_index(n, token);
       }
     }
-    int i = 0;
-    const auto [end, error] = std::from_chars(index.data(), index.data() + index.size(), i);
-    if (error != std::errc() || end != index.data() + index.size()) fail(form, token);
+    std::int64_t i = 0;
+    const char* const last = index.data() + index.size();
+    const auto [end, error] = std::from_chars(index.data(), last, i);
+    if (end != last || (error != std::errc() && error != std::errc::result_out_of_range)) {
+      fail(form, token);
+    }
     // Positive indices count from 1 at the first vertex of the file, negative ones back from the
-    // last vertex read so far (−1 is the latest).
+    // last vertex read so far (−1 is the latest). An integer beyond the range of int64 (and so of
+    // any vertex count) is out of range like any other too large index.
     const auto count = static_cast<std::int64_t>(vertices_.size());
-    const std::int64_t zero_based = i > 0 ? std::int64_t{i} - 1 : count + i;
+    const bool representable = error == std::errc();
+    const std::int64_t zero_based = !representable ? -1 : (i > 0 ? i - 1 : count + i);
     if (i == 0 || zero_based < 0 || zero_based >= count) {
       const std::string range =
           count == 0 ? std::string("none (no vertex read yet)")
@@ -217,29 +272,77 @@ class ObjParser {
   std::vector<std::array<int, 3>> faces_;
 };
 
+/// The kind of a file that is not a regular file, for a message.
+std::string file_kind(std::filesystem::file_type type) {
+  using std::filesystem::file_type;
+  switch (type) {
+    case file_type::fifo:
+      return "a FIFO (named pipe)";
+    case file_type::character:
+      return "a character device";
+    case file_type::block:
+      return "a block device";
+    case file_type::socket:
+      return "a socket";
+    default:
+      return "a file of an unknown type";
+  }
+}
+
+/// Closes a file of C stdio.
+struct CloseFile {
+  void operator()(std::FILE* file) const { std::fclose(file); }
+};
+
+/// The text of errno's error, or a stand-in where the library left errno unset.
+std::string errno_reason(int error) {
+  return error != 0 ? std::generic_category().message(error) : std::string("unknown reason");
+}
+
 }  // namespace
 
 TriangleMesh read_obj(const std::filesystem::path& path) {
   const std::string name = path.string();
+  const std::string cannot = name + ": cannot read the OBJ file: ";
   std::error_code ec;
   const auto status = std::filesystem::status(path, ec);
-  if (!std::filesystem::exists(status)) {
-    throw MeshError(name + ": cannot read the OBJ file: no such file");
+  if (status.type() == std::filesystem::file_type::not_found) {
+    // ENOENT, or ENOTDIR for a path through a file: either way no file has this name.
+    const bool plain = !ec || ec == std::errc::no_such_file_or_directory;
+    throw MeshError(cannot + "no such file" + (plain ? "" : " (" + ec.message() + ")"));
+  }
+  if (ec) {
+    // The path may name a file, but it cannot be examined: a loop of symbolic links, a name
+    // too long, a directory on the way that may not be searched.
+    throw MeshError(cannot + "cannot examine the path: " + ec.message());
   }
   if (std::filesystem::is_directory(status)) {
-    throw MeshError(name + ": cannot read the OBJ file: it is a directory");
+    throw MeshError(cannot + "it is a directory");
   }
   if (!std::filesystem::is_regular_file(status)) {
-    // A device or a pipe (/dev/zero, a FIFO) may never end: reading it could hang.
-    throw MeshError(name + ": cannot read the OBJ file: not a regular file");
+    // A device or a pipe (/dev/zero, a FIFO) may never end, and opening a FIFO blocks until a
+    // writer comes: it is refused from its type, without being opened.
+    throw MeshError(cannot + "not a regular file but " + file_kind(status.type()) +
+                    ", whose reading might never end");
   }
-  std::ifstream in(path, std::ios::binary);
-  if (!in) {
-    throw MeshError(name + ": cannot open the OBJ file for reading");
+  // C stdio rather than a stream: it reports the reason of a failure in errno, where a file
+  // stream throws std::ios_base::failure on a read error (EIO) or says nothing.
+  errno = 0;
+  const std::unique_ptr<std::FILE, CloseFile> file(std::fopen(name.c_str(), "rb"));
+  if (!file) {
+    throw MeshError(name + ": cannot open the OBJ file for reading: " + errno_reason(errno));
   }
-  const std::string text{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-  if (in.bad()) {
-    throw MeshError(name + ": cannot read the OBJ file: read error");
+  std::string text;
+  std::array<char, 1 << 16> buffer;
+  for (;;) {
+    errno = 0;
+    const std::size_t n = std::fread(buffer.data(), 1, buffer.size(), file.get());
+    text.append(buffer.data(), n);
+    if (n < buffer.size()) break;
+  }
+  if (std::ferror(file.get())) {
+    throw MeshError(cannot + "read error after " + std::to_string(text.size()) +
+                    " bytes: " + errno_reason(errno));
   }
   return ObjParser(name).parse(text);
 }

@@ -30,6 +30,16 @@ void require_valid(const RigidBody& body, std::string_view where) {
                             format_number(body.K_Theta[i]));
     }
   }
+  // Θ_k = ∫(x_i² + x_j²) dm ≤ ∫(x_j² + x_k²) dm + ∫(x_k² + x_i²) dm = Θ_i + Θ_j.
+  const double largest = body.K_Theta.maxCoeff();
+  const double others = body.K_Theta.sum() - largest;
+  if (others < largest * (1.0 - kInertiaTolerance)) {
+    throw InvalidArgument(std::string(where) + ": the principal moments K_Theta = (" +
+                          format_number(body.K_Theta[0]) + ", " + format_number(body.K_Theta[1]) +
+                          ", " + format_number(body.K_Theta[2]) +
+                          ") break the triangle inequality: the largest exceeds the sum of the "
+                          "other two, which no mass distribution does");
+  }
 }
 
 namespace {

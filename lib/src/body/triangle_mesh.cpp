@@ -158,6 +158,19 @@ void require_closed_oriented(const TriangleMesh& mesh, std::string_view source) 
     const Vector3 c = mesh.V.row(mesh.F(f, 2)).transpose();
     six_volume += a.dot(b.cross(c));
   }
+  if (!std::isfinite(six_volume)) {
+    // Finite coordinates, a sum that is not: some triple product a·(b × c) overflowed (inf, or
+    // inf − inf = NaN). Its sign says nothing about the orientation.
+    Eigen::Index row = 0;
+    Eigen::Index col = 0;
+    const double largest = mesh.V.cwiseAbs().maxCoeff(&row, &col);
+    throw MeshError(where +
+                    ": coordinates too large: the signed volume Σ a·(b × c)/6 overflows "
+                    "double (it is not finite) with vertex coordinates up to " +
+                    format_number(largest) + " in magnitude (vertex " + std::to_string(row) +
+                    ", coordinate " + "xyz"[col] +
+                    "); expected magnitudes whose cubes fit in a double (below about 5e102)");
+  }
   if (!(six_volume > 0.0)) {
     throw MeshError(where +
                     ": expected outward-oriented faces (counter-clockwise seen from outside) "

@@ -7,12 +7,30 @@
 /// its error stack is switched off while grbd reads (the innermost HDF5 message is put into the
 /// grbd::Error instead), and the calls into HDF5 are serialized by a mutex because the library is
 /// not built thread-safe.
+///
+/// Nothing the file declares is trusted before it is checked against something else:
+/// - the path must name a regular file (a FIFO or a device could block the reader forever), and
+///   every group and dataset opened must be reached through hard links only (an external link can
+///   name any file, a pipe included; a soft link is refused with it); datasets whose data lie in
+///   other files (external storage, virtual datasets) are refused too;
+/// - every element type is a standard integer or an IEEE 754 float, and a dataset stored without
+///   compression cannot declare more bytes than the whole file has;
+/// - the sizes are checked against each other before anything is allocated: n (the contacts) and
+///   m (the degrees of freedom) come from the headers of W, or of M and H, and every vector, index
+///   and value dataset must have the length they imply (mu n entries, q and w 3n, f m, the
+///   entries of a sparse matrix at most nzmax);
+/// - the problem read is checked as a whole (validate()), and a refusal names the file and the
+///   dataset.
 
 #include "grbd/contact/fclib.hpp"
 
+#include <fcntl.h>
 #include <hdf5.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -34,6 +52,13 @@ using SparseMatrix = Eigen::SparseMatrix<double>;
 /// The largest row or column count, entry count or vector length read: Eigen's sparse matrices
 /// index with int.
 constexpr std::int64_t kMaxIndex = std::numeric_limits<int>::max();
+
+/// The longest fixed-length info string read (title, description, math_info): 1 MiB.
+constexpr std::size_t kMaxStringBytes = std::size_t{1} << 20;
+
+/// The largest chunk of a chunked dataset that is larger than the dataset's own data: HDF5 reads
+/// (and, if compressed, inflates) whole chunks, so a chunk size is an allocation.
+constexpr std::uint64_t kMaxChunkBytes = std::uint64_t{8} << 20;
 
 /// Serializes grbd's calls into HDF5 (and the error-printing switch below).
 std::mutex& hdf5_mutex() {
@@ -58,8 +83,8 @@ class QuietErrors {
   void* data_ = nullptr;
 };
 
-/// An HDF5 identifier (file, group, dataset, dataspace, datatype) that is closed when the Handle
-/// goes out of scope. A negative id is "no object".
+/// An HDF5 identifier (file, group, dataset, dataspace, datatype, property list) that is closed
+/// when the Handle goes out of scope. A negative id is "no object".
 class Handle {
  public:
   using Close = herr_t (*)(hid_t);
@@ -141,15 +166,37 @@ std::string object_kind(H5I_type_t type) {
   }
 }
 
+/// Whether `type` is one of HDF5's standard integer types (1, 2, 4 or 8 bytes, signed or not,
+/// either byte order): a type whose size, precision or offset was damaged is none of them.
+bool standard_integer(hid_t type) {
+  for (const hid_t standard :
+       {H5T_STD_I8LE, H5T_STD_I8BE, H5T_STD_U8LE, H5T_STD_U8BE, H5T_STD_I16LE, H5T_STD_I16BE,
+        H5T_STD_U16LE, H5T_STD_U16BE, H5T_STD_I32LE, H5T_STD_I32BE, H5T_STD_U32LE, H5T_STD_U32BE,
+        H5T_STD_I64LE, H5T_STD_I64BE, H5T_STD_U64LE, H5T_STD_U64BE}) {
+    if (H5Tequal(type, standard) > 0) return true;
+  }
+  return false;
+}
+
+/// Whether `type` is an IEEE 754 double or single in either byte order.
+bool ieee_float(hid_t type) {
+  for (const hid_t standard : {H5T_IEEE_F64LE, H5T_IEEE_F64BE, H5T_IEEE_F32LE, H5T_IEEE_F32BE}) {
+    if (H5Tequal(type, standard) > 0) return true;
+  }
+  return false;
+}
+
 /// What a dataset's elements must be.
 enum class Element { integer, real, string };
 
-/// An open dataset with its shape: `length` entries (1 for a scalar dataspace).
+/// An open, checked dataset: its elements are of the kind asked for, it is scalar or
+/// one-dimensional with `length` entries (1 for a scalar dataspace), and its data lie in the file.
 struct Dataset {
   std::string name;
   Handle dataset;
   Handle type;
   hsize_t length = 0;
+  bool variable_string = false;
 };
 
 /// The header {m, n, nz, nzmax} of an FCLIB sparse matrix.
@@ -161,10 +208,28 @@ struct MatrixHeader {
   std::int64_t nzmax = 0;
 };
 
+/// A sparse matrix's header and its datasets p, i, x, opened and checked against the header (for
+/// compressed storage the lengths of i and x are checked once p is read).
+struct MatrixData {
+  MatrixHeader h;
+  Dataset p;
+  Dataset i;
+  Dataset x;
+};
+
 std::string storage_name(std::int64_t nz) {
   if (nz == -1) return "compressed columns (nz = -1)";
   if (nz == -2) return "compressed rows (nz = -2)";
   return "triplets (nz = " + std::to_string(nz) + ")";
+}
+
+std::string shape_text(std::int64_t rows, std::int64_t cols) {
+  return std::to_string(rows) + " × " + std::to_string(cols);
+}
+
+/// The printable prefix of the `size` bytes at `text`, up to the first NUL.
+std::string bounded_string(const char* text, std::size_t size) {
+  return std::string(text, std::find(text, text + size, '\0'));
 }
 
 /// An open FCLIB file and the checked reads of its objects. Every failure throws grbd::Error whose
@@ -172,10 +237,7 @@ std::string storage_name(std::int64_t nz) {
 class File {
  public:
   explicit File(const std::filesystem::path& path) : name_(path.string()) {
-    std::error_code error;
-    const auto status = std::filesystem::status(path, error);
-    if (!std::filesystem::exists(status)) fail("no such file");
-    if (std::filesystem::is_directory(status)) fail("is a directory, expected an HDF5 file");
+    require_regular_file(path);
     const htri_t is_hdf5 = H5Fis_hdf5(name_.c_str());
     if (is_hdf5 == 0) fail("is not an HDF5 file (no HDF5 signature found)");
     if (is_hdf5 < 0) fail("cannot be read as an HDF5 file" + hdf5_message());
@@ -190,16 +252,22 @@ class File {
 
   const std::string& name() const { return name_; }
 
+  /// The size of the file in bytes.
+  std::uint64_t size() const { return size_; }
+
   /// Whether `object` (an absolute path such as "/fclib_local/R") exists: every component is a
-  /// link that resolves, every component but the last a group.
+  /// link that resolves, every component but the last a group. A component that is a soft or an
+  /// external link is refused (it exists, but grbd does not follow it).
   bool has(const std::string& object) const {
     std::size_t start = 1;
     while (start <= object.size()) {
       const std::size_t end = std::min(object.find('/', start), object.size());
       const std::string prefix = object.substr(0, end);
+      const bool last = end == object.size();
       if (H5Lexists(file_.get(), prefix.c_str(), H5P_DEFAULT) <= 0) return false;
+      require_hard_link(prefix, last ? "a group or dataset" : "a group");
       if (H5Oexists_by_name(file_.get(), prefix.c_str(), H5P_DEFAULT) <= 0) return false;
-      if (end < object.size()) {
+      if (!last) {
         const Handle handle(H5Oopen(file_.get(), prefix.c_str(), H5P_DEFAULT), H5Oclose);
         if (!handle.valid() || H5Iget_type(handle.get()) != H5I_GROUP) return false;
       }
@@ -208,8 +276,8 @@ class File {
     return true;
   }
 
-  /// Opens `object`, which must be a group or a dataset (`expected`); names the first missing
-  /// group on the way, or what the object is instead.
+  /// Opens `object`, which must be a group or a dataset (`expected`) reached through hard links
+  /// only; names the first missing group on the way, or what the object is instead.
   Handle open(const std::string& object, H5I_type_t expected) const {
     const std::string what = expected == H5I_GROUP ? "group" : "dataset";
     std::size_t start = 1;
@@ -217,8 +285,12 @@ class File {
       const std::size_t end = std::min(object.find('/', start), object.size());
       const std::string prefix = object.substr(0, end);
       const bool last = end == object.size();
-      if (H5Lexists(file_.get(), prefix.c_str(), H5P_DEFAULT) <= 0 ||
-          H5Oexists_by_name(file_.get(), prefix.c_str(), H5P_DEFAULT) <= 0) {
+      if (H5Lexists(file_.get(), prefix.c_str(), H5P_DEFAULT) <= 0) {
+        if (last) fail(what + " " + object + " is missing");
+        fail("group " + prefix + " is missing (expected " + what + " " + object + ")");
+      }
+      require_hard_link(prefix, last ? "a " + what : "a group holding " + what + " " + object);
+      if (H5Oexists_by_name(file_.get(), prefix.c_str(), H5P_DEFAULT) <= 0) {
         if (last) fail(what + " " + object + " is missing");
         fail("group " + prefix + " is missing (expected " + what + " " + object + ")");
       }
@@ -238,9 +310,28 @@ class File {
     fail("expected the path of a " + what + ", found \"" + object + "\"");
   }
 
-  /// Opens dataset `name` and checks its element class and rank: a scalar or one-dimensional
-  /// dataspace (an empty one counts as 0 entries).
+  /// Opens dataset `name` and checks its element type, its rank (a scalar or one-dimensional
+  /// dataspace, an empty one counts as 0 entries) and that its data lie in this file and fit in
+  /// it. Nothing of its data is read.
   Dataset dataset(const std::string& name, Element element) const {
+    Dataset d = open_dataset(name, element);
+    check_storage(d);
+    return d;
+  }
+
+  /// Opens dataset `name` as dataset() does, and checks that it has `count` entries, or at least
+  /// `count` if `at_least`, before its storage: `expected` says where count comes from, e.g.
+  /// "n + 1 = 31".
+  Dataset dataset(const std::string& name, Element element, std::int64_t count, bool at_least,
+                  const std::string& expected) const {
+    Dataset d = open_dataset(name, element);
+    check_length(d, count, at_least, expected);
+    check_storage(d);
+    return d;
+  }
+
+  /// Opens dataset `name` and checks its element type and rank (see dataset()).
+  Dataset open_dataset(const std::string& name, Element element) const {
     Dataset d;
     d.name = name;
     d.dataset = open(name, H5I_DATASET);
@@ -249,18 +340,7 @@ class File {
     if (!d.type.valid() || !space.valid()) {
       fail("cannot read the type or shape of dataset " + name + hdf5_message());
     }
-    const H5T_class_t type_class = H5Tget_class(d.type.get());
-    const bool accepted = element == Element::integer ? type_class == H5T_INTEGER
-                          : element == Element::real
-                              ? (type_class == H5T_FLOAT || type_class == H5T_INTEGER)
-                              : type_class == H5T_STRING;
-    if (!accepted) {
-      const char* expected = element == Element::integer ? "integer"
-                             : element == Element::real  ? "floating-point"
-                                                         : "string";
-      fail("dataset " + name + " holds " + type_class_name(type_class) + " data, expected " +
-           expected + " data");
-    }
+    check_element(d, element);
     switch (H5Sget_simple_extent_type(space.get())) {
       case H5S_NULL:
         d.length = 0;
@@ -275,7 +355,9 @@ class File {
                ", expected a one-dimensional dataset");
         }
         hsize_t dims[1] = {0};
-        H5Sget_simple_extent_dims(space.get(), dims, nullptr);
+        if (H5Sget_simple_extent_dims(space.get(), dims, nullptr) != 1) {
+          fail("cannot read the shape of dataset " + name + hdf5_message());
+        }
         d.length = dims[0];
         break;
       }
@@ -308,6 +390,16 @@ class File {
     return values;
   }
 
+  /// The first `count` integers of the dataset d.
+  std::vector<std::int64_t> integers(const Dataset& d, std::int64_t count) const {
+    return read<std::int64_t>(d, static_cast<hsize_t>(count), H5T_NATIVE_INT64);
+  }
+
+  /// The first `count` reals of the dataset d, each finite.
+  std::vector<double> reals(const Dataset& d, std::int64_t count) const {
+    return finite(d.name, read<double>(d, static_cast<hsize_t>(count), H5T_NATIVE_DOUBLE));
+  }
+
   /// The single integer of dataset `name`.
   std::int64_t integer(const std::string& name) const {
     const Dataset d = dataset(name, Element::integer);
@@ -317,36 +409,6 @@ class File {
     }
     return read<std::int64_t>(d, 1, H5T_NATIVE_INT64).front();
   }
-
-  /// The first `count` integers of dataset `name`, which must have `count` entries, or at least
-  /// `count` if `at_least`; `expected` says where count comes from, e.g. "n + 1 = 31".
-  std::vector<std::int64_t> integers(const std::string& name, std::int64_t count, bool at_least,
-                                     const std::string& expected) const {
-    const Dataset d = dataset(name, Element::integer);
-    check_length(d, count, at_least, expected);
-    return read<std::int64_t>(d, static_cast<hsize_t>(count), H5T_NATIVE_INT64);
-  }
-
-  /// The first `count` finite reals of dataset `name` (see integers()).
-  std::vector<double> reals(const std::string& name, std::int64_t count, bool at_least,
-                            const std::string& expected) const {
-    const Dataset d = dataset(name, Element::real);
-    check_length(d, count, at_least, expected);
-    return finite(d.name, read<double>(d, static_cast<hsize_t>(count), H5T_NATIVE_DOUBLE));
-  }
-
-  /// All finite reals of dataset `name`, a vector of at most kMaxIndex / 3 entries.
-  std::vector<double> reals(const std::string& name) const {
-    const Dataset d = dataset(name, Element::real);
-    if (d.length > static_cast<hsize_t>(kMaxIndex / 3)) {
-      fail("dataset " + name + " has " + std::to_string(d.length) + " entries, more than the " +
-           std::to_string(kMaxIndex / 3) + " that grbd reads");
-    }
-    return finite(d.name, read<double>(d, d.length, H5T_NATIVE_DOUBLE));
-  }
-
-  /// The number of entries of dataset `name` (any numeric type).
-  hsize_t length(const std::string& name) const { return dataset(name, Element::real).length; }
 
   /// The string of dataset `name` (a scalar or a one-entry dataset, fixed or variable length).
   std::string string(const std::string& name) const {
@@ -358,9 +420,7 @@ class File {
     const Handle memory_type(H5Tcopy(H5T_C_S1), H5Tclose);
     if (!memory_type.valid()) fail("cannot read dataset " + name + hdf5_message());
     H5Tset_cset(memory_type.get(), H5Tget_cset(d.type.get()));
-    const htri_t variable = H5Tis_variable_str(d.type.get());
-    if (variable < 0) fail("cannot read the string type of dataset " + name + hdf5_message());
-    if (variable > 0) {
+    if (d.variable_string) {
       H5Tset_size(memory_type.get(), H5T_VARIABLE);
       char* text = nullptr;
       if (H5Dread(d.dataset.get(), memory_type.get(), H5S_ALL, H5S_ALL, H5P_DEFAULT, &text) < 0) {
@@ -371,8 +431,7 @@ class File {
       if (space.valid()) H5Dvlen_reclaim(memory_type.get(), space.get(), H5P_DEFAULT, &text);
       return result;
     }
-    const std::size_t size = H5Tget_size(d.type.get());
-    if (size == 0) fail("cannot read the string size of dataset " + name + hdf5_message());
+    const std::size_t size = H5Tget_size(d.type.get());  // checked: 1 to kMaxStringBytes
     H5Tset_size(memory_type.get(), size);
     H5Tset_strpad(memory_type.get(), H5T_STR_NULLPAD);
     std::vector<char> buffer(size, '\0');
@@ -380,8 +439,7 @@ class File {
         0) {
       fail("cannot read dataset " + name + hdf5_message());
     }
-    std::string result(buffer.data(),
-                       std::find(buffer.begin(), buffer.end(), '\0') - buffer.begin());
+    std::string result = bounded_string(buffer.data(), buffer.size());
     if (H5Tget_strpad(d.type.get()) == H5T_STR_SPACEPAD) {
       result.erase(result.find_last_not_of(' ') + 1);
     }
@@ -418,18 +476,48 @@ class File {
     if (h.nzmax < 0) {
       fail("dataset " + group + "/nzmax is " + std::to_string(h.nzmax) + ", expected >= 0");
     }
+    if (h.nz > h.nzmax) {
+      fail("dataset " + group + "/nz declares " + std::to_string(h.nz) +
+           " triplets, more than nzmax = " + std::to_string(h.nzmax) + " (dataset " + group +
+           "/nzmax), the room for entries the matrix was written with");
+    }
     return h;
   }
 
-  /// Reads the entries of the sparse matrix with header h, checks every index and sums duplicates.
-  SparseMatrix matrix(const MatrixHeader& h) const {
+  /// Opens the datasets p, i and x of the sparse matrix with header h and checks their lengths
+  /// against the header: for triplets each has at least nz entries, for compressed storage p has
+  /// one more entry than columns (rows). Nothing is read.
+  MatrixData matrix_data(const MatrixHeader& h) const {
+    const std::string& g = h.group;
+    MatrixData data;
+    data.h = h;
+    if (h.nz >= 0) {
+      const std::string expected = "nz = " + std::to_string(h.nz);
+      data.i = dataset(g + "/i", Element::integer, h.nz, true, expected);
+      data.p = dataset(g + "/p", Element::integer, h.nz, true, expected);
+      data.x = dataset(g + "/x", Element::real, h.nz, true, expected);
+    } else {
+      const bool by_columns = h.nz == -1;
+      const std::int64_t outer = by_columns ? h.n : h.m;
+      data.p = dataset(g + "/p", Element::integer, outer + 1, false,
+                       std::string(by_columns ? "n" : "m") + " + 1 = " + std::to_string(outer + 1) +
+                           " for " + storage_name(h.nz));
+      data.i = dataset(g + "/i", Element::integer);
+      data.x = dataset(g + "/x", Element::real);
+    }
+    return data;
+  }
+
+  /// Reads the entries of the sparse matrix (see matrix_data()), checks every index and sums
+  /// duplicates.
+  SparseMatrix matrix(const MatrixData& data) const {
+    const MatrixHeader& h = data.h;
     const std::string& g = h.group;
     std::vector<Eigen::Triplet<double, int>> entries;
     if (h.nz >= 0) {
-      const std::string expected = "nz = " + std::to_string(h.nz);
-      const auto rows = integers(g + "/i", h.nz, true, expected);
-      const auto cols = integers(g + "/p", h.nz, true, expected);
-      const auto x = reals(g + "/x", h.nz, true, expected);
+      const auto rows = integers(data.i, h.nz);
+      const auto cols = integers(data.p, h.nz);
+      const auto x = reals(data.x, h.nz);
       entries.reserve(x.size());
       for (std::size_t k = 0; k < x.size(); ++k) {
         check_index(g + "/i", "row", rows[k], h.m, k);
@@ -441,9 +529,7 @@ class File {
       const std::int64_t outer = by_columns ? h.n : h.m;
       const std::int64_t inner = by_columns ? h.m : h.n;
       const std::string outer_name = by_columns ? "n" : "m";
-      const auto p = integers(
-          g + "/p", outer + 1, false,
-          outer_name + " + 1 = " + std::to_string(outer + 1) + " for " + storage_name(h.nz));
+      const auto p = integers(data.p, outer + 1);
       if (p.front() != 0) {
         fail("dataset " + g + "/p starts with " + std::to_string(p.front()) + ", expected 0");
       }
@@ -456,13 +542,16 @@ class File {
         }
       }
       const std::int64_t count = p.back();
-      if (count > kMaxIndex) {
-        fail("dataset " + g + "/p ends with " + std::to_string(count) + ", more than the " +
-             std::to_string(kMaxIndex) + " entries that grbd reads");
+      if (count > h.nzmax) {
+        fail("dataset " + g + "/p ends with p[" + outer_name + "] = " + std::to_string(count) +
+             " entries, more than nzmax = " + std::to_string(h.nzmax) + " (dataset " + g +
+             "/nzmax), the room for entries the matrix was written with");
       }
       const std::string expected = "p[" + outer_name + "] = " + std::to_string(count);
-      const auto index = integers(g + "/i", count, true, expected);
-      const auto x = reals(g + "/x", count, true, expected);
+      check_length(data.i, count, true, expected);
+      check_length(data.x, count, true, expected);
+      const auto index = integers(data.i, count);
+      const auto x = reals(data.x, count);
       entries.reserve(x.size());
       for (std::int64_t k = 0; k < outer; ++k) {
         for (auto e = p[static_cast<std::size_t>(k)]; e < p[static_cast<std::size_t>(k) + 1]; ++e) {
@@ -503,8 +592,8 @@ class File {
     } else if (has("/fclib_global/G")) {
       const MatrixHeader G = header("/fclib_global/G");
       if (G.m > 0 && G.n > 0) {
-        fail("has equality constraints (/fclib_global/G is " + std::to_string(G.m) + " × " +
-             std::to_string(G.n) + "); grbd reads only problems without equality constraints");
+        fail("has equality constraints (/fclib_global/G is " + shape_text(G.m, G.n) +
+             "); grbd reads only problems without equality constraints");
       }
     }
   }
@@ -522,25 +611,221 @@ class File {
     fail("holds neither group /fclib_local nor /fclib_global: not an FCLIB problem");
   }
 
-  /// The friction coefficients at `name`, finite and ≥ 0.
-  std::vector<double> friction_coefficients(const std::string& name) const {
-    std::vector<double> mu = reals(name);
+  /// The friction coefficients of the dataset d (n entries), finite and ≥ 0.
+  std::vector<double> friction_coefficients(const Dataset& d, std::int64_t n) const {
+    std::vector<double> mu = reals(d, n);
     for (std::size_t k = 0; k < mu.size(); ++k) {
       if (mu[k] < 0.0) {
-        fail("dataset " + name + " entry " + std::to_string(k) + " is " + format_number(mu[k]) +
+        fail("dataset " + d.name + " entry " + std::to_string(k) + " is " + format_number(mu[k]) +
              ", expected a friction coefficient >= 0");
       }
     }
     return mu;
   }
 
- private:
   void check_length(const Dataset& d, std::int64_t count, bool at_least,
                     const std::string& expected) const {
     const auto n = static_cast<hsize_t>(count);
     if (at_least ? d.length < n : d.length != n) {
       fail("dataset " + d.name + " has " + std::to_string(d.length) + " entries, expected " +
            (at_least ? "at least " : "") + expected);
+    }
+  }
+
+ private:
+  /// Refuses a path that is not a regular file, that does not exist or that cannot be opened for
+  /// reading, each with its own message, before HDF5 opens it: opening a FIFO blocks until a
+  /// writer comes, forever if none does. Records the file's size.
+  void require_regular_file(const std::filesystem::path& path) {
+    std::error_code error;
+    const std::filesystem::file_status status = std::filesystem::status(path, error);
+    const std::string reason = error ? " (" + error.message() + ")" : std::string();
+    switch (status.type()) {
+      case std::filesystem::file_type::regular:
+        break;
+      case std::filesystem::file_type::not_found:
+        fail("no such file" + reason);
+      case std::filesystem::file_type::directory:
+        fail("is a directory, expected an HDF5 file");
+      case std::filesystem::file_type::fifo:
+        fail(
+            "is a FIFO (named pipe), not a regular file: grbd reads FCLIB problems from regular "
+            "files only (reading a pipe blocks until something writes to it)");
+      case std::filesystem::file_type::socket:
+        fail("is a socket, not a regular file: grbd reads FCLIB problems from regular files only");
+      case std::filesystem::file_type::block:
+      case std::filesystem::file_type::character:
+        fail("is a device, not a regular file: grbd reads FCLIB problems from regular files only");
+      default:
+        if (error) fail("cannot be accessed" + reason);
+        fail("is not a regular file: grbd reads FCLIB problems from regular files only");
+    }
+    // O_NONBLOCK: should the path have been replaced by a FIFO since, open() does not wait.
+    const int fd = ::open(name_.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC | O_NOCTTY);
+    if (fd < 0) {
+      const int code = errno;
+      fail("cannot be opened for reading (" + std::system_category().message(code) + ")");
+    }
+    struct stat info {};
+    const int stat_result = ::fstat(fd, &info);
+    ::close(fd);
+    if (stat_result != 0 || !S_ISREG(info.st_mode)) {
+      fail("is not a regular file: grbd reads FCLIB problems from regular files only");
+    }
+    size_ = static_cast<std::uint64_t>(info.st_size);
+  }
+
+  /// Refuses `object` unless it is a hard link: soft and external links (and user-defined ones)
+  /// are not followed. `what` says what was expected there.
+  void require_hard_link(const std::string& object, const std::string& what) const {
+    H5L_info_t info;
+    if (H5Lget_info(file_.get(), object.c_str(), &info, H5P_DEFAULT) < 0) {
+      fail("cannot read the link " + object + hdf5_message());
+    }
+    if (info.type == H5L_TYPE_HARD) return;
+    std::string kind = "a user-defined link";
+    std::string target;
+    if (info.type == H5L_TYPE_SOFT || info.type == H5L_TYPE_EXTERNAL) {
+      const bool soft = info.type == H5L_TYPE_SOFT;
+      kind = soft ? "a soft link" : "an external link";
+      const std::size_t size = info.u.val_size;
+      if (size > 0 && size <= 4096) {
+        std::vector<char> value(size + 2, '\0');  // NUL-terminated whatever the link holds
+        if (H5Lget_val(file_.get(), object.c_str(), value.data(), size, H5P_DEFAULT) >= 0) {
+          if (soft) {
+            target = " to " + bounded_string(value.data(), size);
+          } else {  // one byte of flags, the file name, NUL, the object's path, NUL
+            const std::string file = bounded_string(value.data() + 1, size - 1);
+            const std::size_t at = std::min(size, file.size() + 2);
+            target = " to " + bounded_string(value.data() + at, size - at) + " in file " + file;
+          }
+        }
+      }
+    }
+    fail(object + " is " + kind + target + ", expected " + what +
+         " stored in this file: grbd follows no links (an external link can name any file, even "
+         "a pipe that blocks forever)");
+  }
+
+  /// Checks the element type of d against `element`: standard integers, IEEE floats (or
+  /// integers where reals are read), strings of at most kMaxStringBytes.
+  void check_element(Dataset& d, Element element) const {
+    const std::string& name = d.name;
+    const hid_t type = d.type.get();
+    const H5T_class_t type_class = H5Tget_class(type);
+    const std::size_t size = H5Tget_size(type);
+    if (element == Element::string) {
+      if (type_class != H5T_STRING) {
+        fail("dataset " + name + " holds " + type_class_name(type_class) +
+             " data, expected string data");
+      }
+      const htri_t variable = H5Tis_variable_str(type);
+      if (variable < 0) fail("cannot read the string type of dataset " + name + hdf5_message());
+      d.variable_string = variable > 0;
+      if (!d.variable_string && (size == 0 || size > kMaxStringBytes)) {
+        fail("dataset " + name + " holds a string of " + std::to_string(size) +
+             " bytes, expected 1 to " + std::to_string(kMaxStringBytes) +
+             " bytes (an info string)");
+      }
+      return;
+    }
+    const bool accepted = element == Element::integer
+                              ? type_class == H5T_INTEGER
+                              : (type_class == H5T_FLOAT || type_class == H5T_INTEGER);
+    if (!accepted) {
+      fail("dataset " + name + " holds " + type_class_name(type_class) + " data, expected " +
+           (element == Element::integer ? "integer" : "floating-point") + " data");
+    }
+    if (type_class == H5T_INTEGER && !standard_integer(type)) {
+      const bool size_ok = size == 1 || size == 2 || size == 4 || size == 8;
+      fail("dataset " + name + " holds integers of " + std::to_string(size) + " bytes" +
+           (size_ok
+                ? " in a non-standard layout (precision " + std::to_string(H5Tget_precision(type)) +
+                      " bits at offset " + std::to_string(H5Tget_offset(type)) + ")"
+                : std::string()) +
+           ", expected standard 1-, 2-, 4- or 8-byte integers");
+    }
+    if (type_class == H5T_FLOAT && !ieee_float(type)) {
+      const bool size_ok = size == 4 || size == 8;
+      fail("dataset " + name + " holds floating-point numbers of " + std::to_string(size) +
+           " bytes" + (size_ok ? " in a non-IEEE layout" : "") +
+           ", expected IEEE 754 doubles (8 bytes) or singles (4 bytes)");
+    }
+  }
+
+  /// Checks that the data of d lie in this file and fit in it: no external storage or virtual
+  /// layout; uncompressed data not larger than the file, a contiguous block inside it, chunks
+  /// all written; compressed data stored at all; chunks not larger than needed.
+  void check_storage(const Dataset& d) const {
+    const std::string& name = d.name;
+    const Handle plist_handle(H5Dget_create_plist(d.dataset.get()), H5Pclose);
+    if (!plist_handle.valid()) fail("cannot read the storage of dataset " + name + hdf5_message());
+    const hid_t plist = plist_handle.get();
+    const H5D_layout_t layout = H5Pget_layout(plist);
+    if (layout == H5D_VIRTUAL) {
+      fail("dataset " + name +
+           " is a virtual dataset, whose data lie in other files: grbd reads only data stored in "
+           "the file itself");
+    }
+    if (layout != H5D_COMPACT && layout != H5D_CONTIGUOUS && layout != H5D_CHUNKED) {
+      fail("cannot read the storage layout of dataset " + name + hdf5_message());
+    }
+    const int external = H5Pget_external_count(plist);
+    if (external != 0) {
+      fail("dataset " + name + " keeps its data in " +
+           (external > 0 ? std::to_string(external) : std::string("some")) +
+           " external file(s): grbd reads only data stored in the file itself");
+    }
+    if (d.variable_string) return;  // its single string lives in the file's heap
+    const std::uint64_t element = H5Tget_size(d.type.get());
+    const std::uint64_t length = d.length;
+    const std::uint64_t bytes =
+        element > 0 && length > std::numeric_limits<std::uint64_t>::max() / element
+            ? std::numeric_limits<std::uint64_t>::max()
+            : length * element;
+    const std::string declared = "dataset " + name + " declares " + std::to_string(length) +
+                                 " entries of " + std::to_string(element) + " bytes (" +
+                                 std::to_string(bytes) + " bytes)";
+    const int filters = layout == H5D_CHUNKED ? H5Pget_nfilters(plist) : 0;
+    if (filters < 0) fail("cannot read the filters of dataset " + name + hdf5_message());
+    if (filters == 0) {
+      if (bytes > size_) {
+        fail(declared + ", more than the " + std::to_string(size_) +
+             " bytes of the whole file: uncompressed data that large cannot be in it");
+      }
+      if (layout == H5D_CONTIGUOUS && bytes > 0) {
+        const haddr_t offset = H5Dget_offset(d.dataset.get());
+        if (offset == HADDR_UNDEF) {
+          fail(declared + " but stores none of them (its data were never written)");
+        }
+        if (offset > size_ || bytes > size_ - offset) {
+          fail(declared + " at byte " + std::to_string(offset) + ", past the end of the " +
+               std::to_string(size_) + "-byte file");
+        }
+      }
+    }
+    if (layout == H5D_CHUNKED) {
+      hsize_t chunk[1] = {0};
+      if (H5Pget_chunk(plist, 1, chunk) != 1) {
+        fail("cannot read the chunks of dataset " + name + hdf5_message());
+      }
+      const std::uint64_t chunk_bytes =
+          chunk[0] > std::numeric_limits<std::uint64_t>::max() / std::max<std::uint64_t>(element, 1)
+              ? std::numeric_limits<std::uint64_t>::max()
+              : chunk[0] * element;
+      if (chunk_bytes > std::max(bytes, kMaxChunkBytes)) {
+        fail("dataset " + name + " is stored in chunks of " + std::to_string(chunk_bytes) +
+             " bytes, more than its " + std::to_string(bytes) + " bytes of data and than " +
+             std::to_string(kMaxChunkBytes) + " bytes");
+      }
+      if (bytes > 0) {
+        const hsize_t stored = H5Dget_storage_size(d.dataset.get());
+        if (stored == 0) fail(declared + " but stores none of them (no chunk was written)");
+        if (filters == 0 && stored < bytes) {
+          fail(declared + " but stores only " + std::to_string(stored) +
+               " bytes of them (chunks never written)");
+        }
+      }
     }
   }
 
@@ -564,11 +849,8 @@ class File {
 
   std::string name_;
   Handle file_;
+  std::uint64_t size_ = 0;
 };
-
-std::string contacts_text(std::size_t n, const std::string& mu) {
-  return "n = " + std::to_string(n) + " contacts, the entries of " + mu;
-}
 
 std::vector<Vector3> to_vector3(const std::vector<double>& values) {
   std::vector<Vector3> result(values.size() / 3);
@@ -578,101 +860,141 @@ std::vector<Vector3> to_vector3(const std::vector<double>& values) {
   return result;
 }
 
-/// Checks that the matrix with header h is rows × cols.
-void require_shape(const File& file, const MatrixHeader& h, std::int64_t rows, std::int64_t cols,
-                   const std::string& expected, const std::string& why) {
-  if (h.m != rows || h.n != cols) {
-    file.fail("matrix " + h.group + " is " + std::to_string(h.m) + " × " + std::to_string(h.n) +
-              ", expected " + expected + " = " + std::to_string(rows) + " × " +
-              std::to_string(cols) + " (" + why + ")");
-  }
-}
+/// The sizes of a problem, from the headers of its matrices: n contacts (W is 3n × 3n, H is
+/// m × 3n), m degrees of freedom (M is m × m) for a global problem.
+struct Sizes {
+  FclibKind kind = FclibKind::local;
+  std::string root;          ///< "/fclib_local" or "/fclib_global"
+  std::int64_t n = 0;        ///< contacts
+  std::int64_t m = 0;        ///< degrees of freedom (global problems)
+  MatrixHeader W, M, H;      ///< the headers read (W for local, M and H for global problems)
+  std::string contacts_why;  ///< where n comes from, for messages
 
-/// What a local and a global problem start with: the group of `kind` (a file of the other kind
-/// is named as such), spacedim = 3, no equality constraints, and μ, which counts the contacts.
-struct ProblemHead {
-  std::vector<double> mu;  ///< one friction coefficient per contact
-  std::int64_t n3 = 0;     ///< 3n, the number of contact unknowns
-  std::string why;         ///< where n comes from, for messages
+  std::string mu_name() const { return root + "/vectors/mu"; }
+  /// "n = <n> (<why>)", the expected length of mu.
+  std::string n_text() const { return "n = " + std::to_string(n) + " (" + contacts_why + ")"; }
   /// "3n = <3n> (<why>)", the expected length of a per-unknown dataset.
-  std::string three_n() const { return "3n = " + std::to_string(n3) + " (" + why + ")"; }
+  std::string three_n() const {
+    return "3n = " + std::to_string(3 * n) + " (" + contacts_why + "; " + mu_name() +
+           " has n = " + std::to_string(n) + " entries)";
+  }
+  /// "m = <m> (...)", the expected length of a per-degree-of-freedom dataset.
+  std::string m_text() const {
+    return "m = " + std::to_string(m) + " (the size of " + M.group + ")";
+  }
 };
 
-ProblemHead read_head(const File& file, FclibKind kind) {
+/// Checks the group of `kind` (a file of the other kind is named as such), spacedim = 3 and the
+/// absence of equality constraints, then reads the headers of W (local) or M and H (global) and
+/// derives n and m from them, checking that they agree. Nothing but the headers is read.
+Sizes read_sizes(const File& file, FclibKind kind) {
   const bool local = kind == FclibKind::local;
-  const std::string root = local ? "/fclib_local" : "/fclib_global";
+  Sizes s;
+  s.kind = kind;
+  s.root = local ? "/fclib_local" : "/fclib_global";
   const std::string other = local ? "/fclib_global" : "/fclib_local";
   const char* name = local ? "local" : "global";
   const char* other_name = local ? "global" : "local";
-  if (!file.has(root)) {
+  if (!file.has(s.root)) {
     if (file.has(other)) {
       file.fail(std::string("holds a ") + other_name + " problem (" + other + "), not a " + name +
-                " one (group " + root + " is missing)");
+                " one (group " + s.root + " is missing)");
     }
-    file.fail("group " + root + " is missing: not a " + name + " FCLIB problem");
+    file.fail("group " + s.root + " is missing: not a " + name + " FCLIB problem");
   }
-  file.open(root, H5I_GROUP);
-  file.require_3d(root);
+  file.open(s.root, H5I_GROUP);
+  file.require_3d(s.root);
   file.require_no_equality_constraints(kind);
-  const std::string mu_name = root + "/vectors/mu";
-  ProblemHead head;
-  head.mu = file.friction_coefficients(mu_name);
-  head.n3 = static_cast<std::int64_t>(3 * head.mu.size());
-  head.why = contacts_text(head.mu.size(), mu_name);
-  return head;
+  if (local) {
+    s.W = file.header("/fclib_local/W");
+    if (s.W.m != s.W.n || s.W.m % 3 != 0) {
+      file.fail("matrix /fclib_local/W is " + shape_text(s.W.m, s.W.n) +
+                ", expected a square 3n × 3n matrix for n contacts");
+    }
+    s.n = s.W.m / 3;
+    s.contacts_why = "/fclib_local/W is " + shape_text(s.W.m, s.W.n) + " = 3n × 3n";
+  } else {
+    s.M = file.header("/fclib_global/M");
+    if (s.M.m != s.M.n) {
+      file.fail("matrix /fclib_global/M is " + shape_text(s.M.m, s.M.n) +
+                ", expected a square m × m mass matrix");
+    }
+    s.m = s.M.m;
+    s.H = file.header("/fclib_global/H");
+    if (s.H.m != s.m || s.H.n % 3 != 0) {
+      file.fail("matrix /fclib_global/H is " + shape_text(s.H.m, s.H.n) +
+                ", expected m × 3n with " + s.m_text() + " and n contacts");
+    }
+    s.n = s.H.n / 3;
+    s.contacts_why = "/fclib_global/H is " + shape_text(s.H.m, s.H.n) + " = m × 3n";
+  }
+  return s;
+}
+
+/// Checks the local problem read with validate() and throws grbd::Error naming the file and the
+/// dataset that failed (`W`, `q`, `mu` are the datasets the problem came from).
+void validate_read(const File& file, const LocalProblem& problem, const std::string& W,
+                   const std::string& q, const std::string& mu) {
+  try {
+    validate(problem);
+  } catch (const InvalidArgument& error) {
+    const std::string message = error.what();
+    const std::string& dataset = message.find("q of contact") != std::string::npos    ? q
+                                 : message.find("mu of contact") != std::string::npos ? mu
+                                                                                      : W;
+    file.fail(dataset + " does not give a valid local problem: " + message);
+  }
 }
 
 LocalProblem read_local(const File& file) {
-  ProblemHead head = read_head(file, FclibKind::local);
+  const Sizes s = read_sizes(file, FclibKind::local);
+  // Every length is checked before anything is read.
+  const Dataset mu = file.dataset(s.mu_name(), Element::real, s.n, false, s.n_text());
+  const Dataset q =
+      file.dataset("/fclib_local/vectors/q", Element::real, 3 * s.n, false, s.three_n());
+  const MatrixData W = file.matrix_data(s.W);
   LocalProblem problem;
-  problem.q = to_vector3(file.reals("/fclib_local/vectors/q", head.n3, false, head.three_n()));
-  const MatrixHeader W = file.header("/fclib_local/W");
-  require_shape(file, W, head.n3, head.n3, "3n × 3n", head.why);
+  problem.mu = file.friction_coefficients(mu, s.n);
+  problem.q = to_vector3(file.reals(q, 3 * s.n));
   problem.W = to_block_sparse(file.matrix(W));
-  problem.mu = std::move(head.mu);
+  validate_read(file, problem, "matrix /fclib_local/W", "dataset /fclib_local/vectors/q",
+                "dataset " + s.mu_name());
   return problem;
 }
 
 GlobalProblem read_global(const File& file) {
-  ProblemHead head = read_head(file, FclibKind::global);
-  const MatrixHeader M = file.header("/fclib_global/M");
-  require_shape(file, M, M.m, M.m, "a square m × m", "m = " + std::to_string(M.m) + " rows");
-  const std::int64_t m = M.m;
-  const std::string m_text = "m = " + std::to_string(m) + " (the size of /fclib_global/M)";
-  const MatrixHeader H = file.header("/fclib_global/H");
-  require_shape(file, H, m, head.n3, "m × 3n", m_text + ", " + head.why);
-  const auto f = file.reals("/fclib_global/vectors/f", m, false, m_text);
-  const auto w = file.reals("/fclib_global/vectors/w", head.n3, false, head.three_n());
+  const Sizes s = read_sizes(file, FclibKind::global);
+  // Every length is checked before anything is read.
+  const Dataset mu = file.dataset(s.mu_name(), Element::real, s.n, false, s.n_text());
+  const Dataset f = file.dataset("/fclib_global/vectors/f", Element::real, s.m, false, s.m_text());
+  const Dataset w =
+      file.dataset("/fclib_global/vectors/w", Element::real, 3 * s.n, false, s.three_n());
+  const MatrixData M = file.matrix_data(s.M);
+  const MatrixData H = file.matrix_data(s.H);
   GlobalProblem problem;
-  problem.f = Eigen::Map<const Eigen::VectorXd>(f.data(), static_cast<Eigen::Index>(f.size()));
-  problem.w = Eigen::Map<const Eigen::VectorXd>(w.data(), static_cast<Eigen::Index>(w.size()));
+  problem.mu = file.friction_coefficients(mu, s.n);
+  const auto f_values = file.reals(f, s.m);
+  const auto w_values = file.reals(w, 3 * s.n);
+  problem.f = Eigen::Map<const Eigen::VectorXd>(f_values.data(), s.m);
+  problem.w = Eigen::Map<const Eigen::VectorXd>(w_values.data(), 3 * s.n);
   problem.M = file.matrix(M);
   problem.H = file.matrix(H);
-  problem.mu = std::move(head.mu);
   return problem;
 }
 
 FclibInfo read_info(const File& file) {
   FclibInfo info;
   info.kind = file.kind();
-  const std::string root = info.kind == FclibKind::local ? "/fclib_local" : "/fclib_global";
-  file.require_3d(root);
-  file.require_no_equality_constraints(info.kind);
-  const std::string mu_name = root + "/vectors/mu";
-  const hsize_t n = file.length(mu_name);
-  if (n > static_cast<hsize_t>(kMaxIndex / 3)) {
-    file.fail("dataset " + mu_name + " has " + std::to_string(n) + " entries, more than the " +
-              std::to_string(kMaxIndex / 3) + " contacts that grbd reads");
-  }
-  info.contacts = static_cast<int>(n);
-  info.title = file.optional_string(root + "/info/title");
-  info.description = file.optional_string(root + "/info/description");
-  info.math_info = file.optional_string(root + "/info/math_info");
+  const Sizes s = read_sizes(file, info.kind);
+  file.dataset(s.mu_name(), Element::real, s.n, false, s.n_text());  // the count agrees
+  info.contacts = static_cast<int>(s.n);
+  info.title = file.optional_string(s.root + "/info/title");
+  info.description = file.optional_string(s.root + "/info/description");
+  info.math_info = file.optional_string(s.root + "/info/math_info");
   const std::string guess = "/guesses/1/r";
   if (file.has(guess)) {
-    const auto n3 = static_cast<std::int64_t>(3 * n);
-    info.guess = to_vector3(file.reals(
-        guess, n3, false, "3n = " + std::to_string(n3) + " (" + contacts_text(n, mu_name) + ")"));
+    const Dataset r = file.dataset(guess, Element::real, 3 * s.n, false, s.three_n());
+    info.guess = to_vector3(file.reals(r, 3 * s.n));
   }
   return info;
 }
@@ -680,24 +1002,25 @@ FclibInfo read_info(const File& file) {
 }  // namespace
 
 /// Opens the file, determines its kind (/fclib_local if present, else /fclib_global), checks
-/// spacedim = 3 and the absence of equality constraints, counts the contacts (the entries of
-/// /fclib_*/vectors/mu) and reads the optional info strings and the guess /guesses/1/r (3n
-/// entries). The matrices are not read.
+/// spacedim = 3 and the absence of equality constraints, counts the contacts (from the header of
+/// W, or of H; /fclib_*/vectors/mu must have one entry each) and reads the optional info strings
+/// and the guess /guesses/1/r (3n entries). The matrices' entries are not read.
 FclibInfo read_fclib_info(const std::filesystem::path& path) {
   const std::lock_guard lock(hdf5_mutex());
   const QuietErrors quiet;
   return read_info(File(path));
 }
 
-/// Reads /fclib_local: spacedim = 3, no R or V, n = the entries of vectors/mu (finite, ≥ 0), q
-/// with 3n finite entries, W 3n × 3n in any storage kind, cut into 3 × 3 blocks.
+/// Reads /fclib_local: spacedim = 3, no R or V, W 3n × 3n in any storage kind (cut into 3 × 3
+/// blocks), mu with n entries (finite, ≥ 0), q with 3n finite entries; the problem passes
+/// validate().
 LocalProblem read_fclib_local(const std::filesystem::path& path) {
   const std::lock_guard lock(hdf5_mutex());
   const QuietErrors quiet;
   return read_local(File(path));
 }
 
-/// Reads /fclib_global: spacedim = 3, no (non-empty) G, μ (n entries), M m × m, H m × 3n, f (m),
+/// Reads /fclib_global: spacedim = 3, no (non-empty) G, M m × m, H m × 3n, μ (n entries), f (m),
 /// w (3n).
 GlobalProblem read_fclib_global(const std::filesystem::path& path) {
   const std::lock_guard lock(hdf5_mutex());
@@ -706,8 +1029,9 @@ GlobalProblem read_fclib_global(const std::filesystem::path& path) {
 }
 
 /// Reads the local problem of the file, or its global problem converted with to_local(); an
-/// InvalidArgument of to_local() (M not positive definite, ...) is thrown again with the file's
-/// path in front.
+/// InvalidArgument of to_local() (M not positive definite or numerically singular, ...) or of
+/// validate() on its result is thrown again with the file's path and the global problem's
+/// datasets in front.
 LocalProblem read_fclib_as_local(const std::filesystem::path& path) {
   GlobalProblem global;
   {
@@ -717,16 +1041,30 @@ LocalProblem read_fclib_as_local(const std::filesystem::path& path) {
     if (file.kind() == FclibKind::local) return read_local(file);
     global = read_global(file);
   }
+  const std::string source =
+      path.string() +
+      ": the global problem /fclib_global (M = /fclib_global/M, H = /fclib_global/H, f and w in "
+      "/fclib_global/vectors)";
+  LocalProblem local;
   try {
-    return to_local(global);
+    local = to_local(global);
   } catch (const InvalidArgument& error) {
-    throw InvalidArgument(path.string() + ": " + error.what());
+    throw InvalidArgument(source + " cannot be put in local form: " + error.what());
   }
+  try {
+    validate(local);
+  } catch (const InvalidArgument& error) {
+    throw InvalidArgument(
+        source + " gives an invalid local problem W = Hᵀ M⁻¹ H, q = Hᵀ M⁻¹ f + w: " + error.what());
+  }
+  return local;
 }
 
 /// Reads the sparse matrix in `group` ("/fclib_local/W", or without the leading slash): checks
 /// the header, the lengths of p, i and x for the storage kind, p monotone from 0 for compressed
-/// storage, every index in range and every value finite; duplicates are summed.
+/// storage, every index in range and every value finite; duplicates are summed. A matrix read on
+/// its own has no vector to check its shape against: a row or column count larger than the file's
+/// size in bytes is refused (grbd allocates 4 bytes per row and per column of it).
 Eigen::SparseMatrix<double> read_fclib_matrix(const std::filesystem::path& path,
                                               const std::string& group) {
   std::string name;  // "/a/b": one leading slash, none repeated or trailing
@@ -742,7 +1080,14 @@ Eigen::SparseMatrix<double> read_fclib_matrix(const std::filesystem::path& path,
   const std::lock_guard lock(hdf5_mutex());
   const QuietErrors quiet;
   const File file(path);
-  return file.matrix(file.header(name));
+  const MatrixHeader h = file.header(name);
+  const auto size = static_cast<std::int64_t>(std::min<std::uint64_t>(file.size(), kMaxIndex));
+  if (h.m > size || h.n > size) {
+    file.fail("matrix " + name + " declares " + shape_text(h.m, h.n) +
+              ", a dimension larger than the file's " + std::to_string(file.size()) +
+              " bytes: no data of the file backs it");
+  }
+  return file.matrix(file.matrix_data(h));
 }
 
 }  // namespace grbd::contact

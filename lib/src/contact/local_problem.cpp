@@ -26,6 +26,8 @@ using SparseMatrix = Eigen::SparseMatrix<double>;
 constexpr double kMassSymmetryTolerance = 1e-8;
 /// Entries of W = Hᵀ M⁻¹ H at most this times max |W| are rounding noise and dropped.
 constexpr double kPruneTolerance = 1e-14;
+/// The unit roundoff of double precision (2⁻⁵²).
+constexpr double kEpsilon = std::numeric_limits<double>::epsilon();
 
 std::string index_pair(std::int64_t i, std::int64_t j) {
   return "(" + std::to_string(i) + ", " + std::to_string(j) + ")";
@@ -64,6 +66,20 @@ void require_finite(const Eigen::VectorXd& v, const char* name) {
     if (!std::isfinite(v[k])) {
       throw InvalidArgument(std::string("to_local: ") + name + " has a non-finite entry " + name +
                             "[" + std::to_string(k) + "] = " + format_number(v[k]));
+    }
+  }
+}
+
+/// Throws InvalidArgument if the computed matrix A (`what`, e.g. "W = Hᵀ M⁻¹ H") has a non-finite
+/// entry: its inputs were finite, so M is too ill-conditioned or H too large for double precision.
+void require_finite_result(const SparseMatrix& A, const char* what) {
+  for (Eigen::Index c = 0; c < A.outerSize(); ++c) {
+    for (SparseMatrix::InnerIterator it(A, c); it; ++it) {
+      if (!std::isfinite(it.value())) {
+        throw InvalidArgument(std::string("to_local: ") + what + " has a non-finite entry W" +
+                              index_pair(it.row(), it.col()) + " = " + format_number(it.value()) +
+                              ": M is too ill-conditioned, or H too large, for double precision");
+      }
     }
   }
 }
@@ -178,7 +194,11 @@ BlockSparseMatrix to_block_sparse(const Eigen::SparseMatrix<double>& W) {
 }
 
 /// y = W x, block row by block row. Throws InvalidArgument if x or y does not have W.size()
-/// entries or if they overlap.
+/// entries, if they overlap, or if the offsets of W disagree with its blocks (row_start not
+/// starting at 0, not monotone, or not ending at the number of blocks and block columns). These
+/// checks cost O(1) and O(n) per call; the block columns themselves are not checked (that would
+/// be O(blocks) per call, as much as the product): W must come from to_block_sparse() or have
+/// passed validate().
 void multiply(const BlockSparseMatrix& W, std::span<const Vector3> x, std::span<Vector3> y) {
   const std::size_t n = W.size();
   if (x.size() != n || y.size() != n) {
@@ -193,6 +213,20 @@ void multiply(const BlockSparseMatrix& W, std::span<const Vector3> x, std::span<
     const Vector3* y_end = y.data() + n;
     if (before(x.data(), y_end) && before(y_begin, x_end)) {
       throw InvalidArgument("multiply: x and y overlap; y = W x needs separate storage");
+    }
+    const auto stored = static_cast<std::int64_t>(W.blocks.size());
+    if (W.row_start.front() != 0 || W.row_start.back() != stored ||
+        W.column.size() != W.blocks.size()) {
+      throw InvalidArgument(
+          "multiply: W.row_start runs from " + std::to_string(W.row_start.front()) + " to " +
+          std::to_string(W.row_start.back()) + " but W has " + std::to_string(W.blocks.size()) +
+          " blocks and " + std::to_string(W.column.size()) + " block columns");
+    }
+    for (std::size_t i = 0; i < n; ++i) {
+      if (W.row_start[i + 1] < W.row_start[i]) {
+        throw InvalidArgument("multiply: W.row_start is not monotone at block row " +
+                              std::to_string(i));
+      }
     }
   }
   for (std::size_t i = 0; i < n; ++i) {
@@ -268,7 +302,8 @@ void validate(const LocalProblem& problem) {
 /// ordering). W is symmetrized, (W + Wᵀ)/2, and entries |W_ij| ≤ 1e-14 max |W| (rounding noise of
 /// the products) are dropped before it is cut into blocks. Throws InvalidArgument if the sizes
 /// disagree (M m × m, H m × 3n, f m, w 3n, μ n), an entry is not finite, M is not symmetric
-/// (relative 1e-8) or not positive definite.
+/// (relative 1e-8), not positive definite or numerically singular (a pivot of its factorization
+/// at most m ε times the largest), or if W or q come out non-finite.
 LocalProblem to_local(const GlobalProblem& global) {
   const Eigen::Index m = global.M.rows();
   const auto n = static_cast<Eigen::Index>(global.mu.size());
@@ -336,17 +371,39 @@ LocalProblem to_local(const GlobalProblem& global) {
                           ") is not positive definite: its LDLᵀ factorization failed");
   }
   const Eigen::VectorXd D = ldlt.vectorD();
+  // The pivot of row and column `row` of M (the factorization permutes M).
+  const auto pivot_text = [&](Eigen::Index k) {
+    const Eigen::Index row = ldlt.permutationPinv().indices()[k];
+    return "pivot " + std::to_string(k) + " of its LDLᵀ factorization (row and column " +
+           std::to_string(row) + " of M, M" + index_pair(row, row) + " = " +
+           format_number(global.M.coeff(row, row)) + ") is " + format_number(D[k]);
+  };
   for (Eigen::Index k = 0; k < D.size(); ++k) {
     if (!(D[k] > 0.0)) {
       throw InvalidArgument("to_local: the mass matrix M (" + size_text(m, m) +
-                            ") is not positive definite: pivot " + std::to_string(k) +
-                            " of its LDLᵀ factorization is " + format_number(D[k]));
+                            ") is not positive definite: " + pivot_text(k));
+    }
+  }
+  // The pivots of an SPD matrix lie between its extreme eigenvalues, so max D / min D is at most
+  // the condition number of M: a pivot below m ε max D proves M numerically singular (cond(M) >
+  // 1/(m ε)), and M⁻¹ would be all rounding error, or overflow.
+  const double smallest = D.maxCoeff() * static_cast<double>(m) * kEpsilon;
+  for (Eigen::Index k = 0; k < D.size(); ++k) {
+    if (D[k] <= smallest) {
+      throw InvalidArgument("to_local: the mass matrix M (" + size_text(m, m) +
+                            ") is numerically singular: " + pivot_text(k) +
+                            ", at most m ε = " + format_number(static_cast<double>(m) * kEpsilon) +
+                            " times the largest pivot " + format_number(D.maxCoeff()) +
+                            " (the condition number of M exceeds 1/(m ε))");
     }
   }
 
   const SparseMatrix X = ldlt.solve(global.H);  // M⁻¹ H
   const SparseMatrix HtX = SparseMatrix(global.H.transpose()) * X;
+  // Checked before pruning, which would drop NaN entries silently.
+  require_finite_result(HtX, "W = Hᵀ M⁻¹ H");
   SparseMatrix W = 0.5 * (HtX + SparseMatrix(HtX.transpose()));
+  require_finite_result(W, "W = (Hᵀ M⁻¹ H + (Hᵀ M⁻¹ H)ᵀ)/2");
   const double threshold = kPruneTolerance * max_abs(W);
   W.prune([threshold](Eigen::Index, Eigen::Index, double value) {
     return std::abs(value) > threshold;
@@ -355,6 +412,15 @@ LocalProblem to_local(const GlobalProblem& global) {
 
   const Eigen::VectorXd Minv_f = ldlt.solve(global.f);
   const Eigen::VectorXd q = global.H.transpose() * Minv_f + global.w;
+  for (Eigen::Index k = 0; k < q.size(); ++k) {
+    if (!std::isfinite(q[k])) {
+      throw InvalidArgument("to_local: q = Hᵀ M⁻¹ f + w has a non-finite entry q[" +
+                            std::to_string(k) + "] = " + format_number(q[k]) + " (contact " +
+                            std::to_string(k / 3) +
+                            "): M is too ill-conditioned, or H, f or w too large, for double "
+                            "precision");
+    }
+  }
   for (Eigen::Index i = 0; i < n; ++i) local.q[static_cast<std::size_t>(i)] = q.segment<3>(3 * i);
   return local;
 }

@@ -487,7 +487,25 @@ SolverResult run_apgd(Model& model, std::vector<Vector3>& lambda, const SolverOp
     xi_prev = xi_x;
     L *= 0.9;
     model.record(xi_x, options.criterion == Criterion::velocity_change);
-    if (monitor.after(k) || k == options.max_iterations) break;
+    if (monitor.after(k)) {
+      if (result.diverged || !frictional || options.criterion == Criterion::natural_residual) break;
+      // Percussions or velocities that stopped changing within a cycle are the solution of this
+      // cycle's convex problem, with the offset s frozen; they solve Coulomb's law only if s is
+      // also the offset μ ‖ξ_T‖ of the iterate itself. Otherwise refresh s, restart and go on.
+      bool consistent = true;
+      for (std::size_t i = 0; i < n && consistent; ++i) {
+        const double s_now = model.mu(i) * norm2d(xi_x[i](1), xi_x[i](2));
+        consistent = std::abs(s_now - s[i]) <= options.abs_tol + options.rel_tol * s_now;
+      }
+      if (consistent) break;
+      result.converged = false;
+      theta = 1.0;
+      for (std::size_t i = 0; i < n; ++i) s[i] = model.mu(i) * norm2d(xi_x[i](1), xi_x[i](2));
+      y = lambda;
+      xi_y = xi_x;
+      last_update = k;
+    }
+    if (k == options.max_iterations) break;
   }
   model.done();
   monitor.finish();

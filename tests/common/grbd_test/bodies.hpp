@@ -37,10 +37,19 @@ struct Describer<body::Loads> {
   }
 };
 
-/// A random body: mass in [0.5, 3), principal moments in [0.1, 3).
+/// Principal moments of a random mass distribution: the second moments a_k = ∫x_k² dm drawn
+/// from [lo/2, hi/2), Θ₁ = a₂ + a₃, Θ₂ = a₃ + a₁, Θ₃ = a₁ + a₂, so that every triple is some
+/// body's (Θ_i + Θ_j ≥ Θ_k, which body::require_valid() demands), each in [lo, hi).
+inline Vector3 random_moments(Random& rng, double lo, double hi) {
+  const Vector3 a(rng.uniform(lo / 2, hi / 2), rng.uniform(lo / 2, hi / 2),
+                  rng.uniform(lo / 2, hi / 2));
+  return {a(1) + a(2), a(2) + a(0), a(0) + a(1)};
+}
+
+/// A random body: mass in [0.5, 3), principal moments of random_moments() in [0.1, 3).
 inline body::RigidBody random_body(Random& rng) {
-  return {rng.uniform(0.5, 3.0),
-          Vector3(rng.uniform(0.1, 3.0), rng.uniform(0.1, 3.0), rng.uniform(0.1, 3.0))};
+  const double m = rng.uniform(0.5, 3.0);
+  return {m, random_moments(rng, 0.1, 3.0)};
 }
 
 /// A random state: r ∈ [−1, 1)³, unit p, v and ω ∈ [−2, 2)³.

@@ -65,7 +65,9 @@ struct MassProperties {
 /// mesh with require_closed_oriented(mesh, source) first (MeshError), then the density
 /// (grbd::InvalidArgument unless finite and > 0). The integrals are taken about the centre of the
 /// mesh's bounding box, so that Steiner's shift to S does not cancel digits for a body far from
-/// the origin of M.
+/// the origin of M. Integrals that overflow double (a mesh larger than about 1e61) are a
+/// MeshError "coordinates too large"; mass or inertia that overflow only with the density are
+/// grbd::InvalidArgument.
 MassProperties mass_properties(const TriangleMesh& mesh, double density,
                                std::string_view source = "mesh");
 
@@ -75,10 +77,18 @@ struct PrincipalAxes {
   Matrix3 A_MK = Matrix3::Identity(); ///< columns: the principal axes in frame M; det = +1
 };
 
+/// Relative round-off allowed in the inequalities that every inertia tensor satisfies,
+/// Θ1 ≥ 0 and Θ1 + Θ2 ≥ Θ3, measured by the largest principal moment: a thin rod and a flat plate
+/// meet them with equality, which a computed tensor meets only up to its round-off.
+inline constexpr double kInertiaTolerance = 1e-10;
+
 /// The principal frame K of Θ (3 × 3, symmetric, frame M): Θ = A_MK diag(K_Theta) A_MKᵀ with
 /// ascending moments and a right-handed orthonormal A_MK (Eigen's self-adjoint eigensolver).
-/// Throws grbd::InvalidArgument for a non-finite Θ or one that is not symmetric to 1e-8 relative.
-/// For repeated moments any orthonormal basis of the eigenspace is returned.
+/// Throws grbd::InvalidArgument for a non-finite Θ (naming the entry), one that is not symmetric
+/// to 1e-8 relative, and one that no body has: a negative principal moment, or moments that break
+/// the triangle inequality Θ1 + Θ2 ≥ Θ3 (both up to kInertiaTolerance relative; a zero moment
+/// passes, RigidBody's require_valid() refuses it). For repeated moments any orthonormal basis of
+/// the eigenspace is returned.
 PrincipalAxes principal_axes(const Matrix3& M_Theta_S);
 
 /// Closed forms (Mirtich 1996 and any table of moments of inertia), centre of mass at the origin;

@@ -19,8 +19,10 @@ struct RigidBody {
 };
 
 /// Throws InvalidArgument unless m and the three principal moments K_Theta are positive and
-/// finite: M must be symmetric positive definite for u̇ = M⁻¹h and T = ½ uᵀMu to make sense. The
-/// message starts with `where`, the name of the checking function.
+/// finite, and the moments satisfy the triangle inequality Θ_i + Θ_j ≥ Θ_k of every body (up to
+/// kInertiaTolerance relative; a rod or a plate meets it with equality): M must be symmetric
+/// positive definite for u̇ = M⁻¹h and T = ½ uᵀMu to make sense, and (1, 1, 5) is no body's
+/// inertia. The message starts with `where`, the name of the checking function.
 void require_valid(const RigidBody& body, std::string_view where);
 
 /// The state of one body: q = (I_r_S, p) ∈ ℝ⁷ with |p| = 1, and u = (I_v_S, K_omega) ∈ ℝ⁶.

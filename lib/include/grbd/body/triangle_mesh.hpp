@@ -40,10 +40,15 @@ class MeshError : public Error {
 /// (−1), and either must name a vertex read before the `f` line. Polygons v0 v1 … with more than
 /// three vertices are split into the fan (v0, v_k, v_k+1), which keeps their orientation.
 /// Ignored: comments (`#` to the end of a line), `vt`, `vn`, `vp`, `o`, `g`, `s`, `usemtl`,
-/// `mtllib`; Windows line ends and a UTF-8 byte order mark are accepted. Anything else (an unknown
-/// statement, a malformed or non-finite number, a face with fewer than three vertices, an index out
-/// of range, a file with no faces) throws MeshError with the message
-/// "FILE:LINE: expected …, found '…'"; a missing or unreadable file is a MeshError naming it.
+/// `mtllib`; Windows line ends and a UTF-8 byte order mark are accepted. A number is read
+/// correctly rounded to double; one below the smallest subnormal (such as 1e-400) rounds to ±0 and
+/// is accepted as such. Anything else (an unknown statement, a malformed or non-finite number, one
+/// that overflows double, a face with fewer than three vertices, an index out of range, a file
+/// with no faces) throws MeshError with the message "FILE:LINE: expected …, found '…'". A file
+/// that does not exist, cannot be examined or opened (with the system's reason), is not a regular
+/// file (a FIFO or a device is refused from its type, without being opened) or fails to read is a
+/// MeshError naming it. Coordinates too large for the volume integrals are found later, by
+/// require_closed_oriented() and mass_properties().
 TriangleMesh read_obj(const std::filesystem::path& path);
 
 /// Writes `mesh` as a Wavefront OBJ file (`comment` as `#` lines, then `v` and `f` lines, 1-based
@@ -75,7 +80,9 @@ MeshTopology analyse_topology(const TriangleMesh& mesh);
 /// Throws MeshError unless `mesh` is a closed, consistently oriented 2-manifold whose enclosed
 /// volume is positive (outward normals). The message starts with `source` (a file name or a
 /// description), gives the counts of MeshTopology and names the first offending edge by its two
-/// vertex indices (or the first offending face).
+/// vertex indices (or the first offending face). Coordinates so large that the signed volume
+/// Σ a·(b × c)/6 overflows (magnitudes beyond about 5e102) are refused as "coordinates too large",
+/// with the largest magnitude and its vertex.
 void require_closed_oriented(const TriangleMesh& mesh, std::string_view source);
 
 /// The rigid (or general affine) image x ↦ A x + r of every vertex; faces unchanged. A must have

@@ -30,7 +30,12 @@ struct BlockSparseMatrix {
 /// Throws InvalidArgument if the matrix is not square with a multiple of 3 rows.
 BlockSparseMatrix to_block_sparse(const Eigen::SparseMatrix<double>& W);
 
-/// y = W x for per-contact vectors x, y (n entries each).
+/// y = W x for per-contact vectors x, y (n entries each): the kernel of the solvers, called every
+/// iteration. It checks only what costs O(1) or O(n) per call (the sizes of x and y, that they do
+/// not overlap, that row_start starts at 0, is monotone and ends at the number of blocks and block
+/// columns) and throws InvalidArgument if one fails. The block columns are not checked: W must come
+/// from to_block_sparse() or belong to a problem that passed validate() (the solvers and the FCLIB
+/// reader validate every problem); a column out of range is undefined behaviour here.
 void multiply(const BlockSparseMatrix& W, std::span<const Vector3> x, std::span<Vector3> y);
 
 /// The local problem: find λ_i ∈ K_μi with ξ = W λ + q satisfying the Coulomb law.
@@ -40,10 +45,14 @@ struct LocalProblem {
   std::vector<double> mu;    ///< friction coefficient per contact
 };
 
-/// Checks a local problem and throws InvalidArgument naming the first bad entry: sizes that
-/// disagree, NaN or Inf in W or q, μ < 0 or not finite, a diagonal block whose diagonal is not
-/// positive. W need not be symmetric: FCLIB files hold W as other codes computed it, and the
-/// Capsules-286 problem's W is asymmetric by 2 % within a diagonal block.
+/// Checks a local problem and throws InvalidArgument naming the first bad entry: a corrupted
+/// block structure (row_start not starting at 0 or not monotone, block columns out of range or not
+/// increasing, a diagonal index that is not the index of the diagonal block, fewer or more blocks
+/// and block columns than row_start says), sizes that disagree, NaN or Inf in W (its diagonal
+/// included) or q, μ < 0 or not finite, a diagonal block whose diagonal is not positive. A problem
+/// that passes is safe for multiply() and the solvers. W need not be symmetric: FCLIB files hold W
+/// as other codes computed it, and the Capsules-286 problem's W is asymmetric by 2 % within a
+/// diagonal block.
 void validate(const LocalProblem& problem);
 
 /// The global problem of FCLIB: M v = H λ + f, ξ = Hᵀ v + w. M (m × m) symmetric positive
@@ -57,7 +66,9 @@ struct GlobalProblem {
 };
 
 /// W = Hᵀ M⁻¹ H and q = Hᵀ M⁻¹ f + w by a sparse Cholesky (LDLᵀ) factorization of M. Throws
-/// InvalidArgument if sizes disagree or M is not positive definite, naming what failed.
+/// InvalidArgument if sizes disagree, an input is not finite, M is not symmetric, not positive
+/// definite or numerically singular (a pivot at most m ε times the largest: cond(M) > 1/(m ε)), or
+/// if W or q come out non-finite, naming what failed.
 LocalProblem to_local(const GlobalProblem& global);
 
 /// ξ = W λ + q for all contacts.

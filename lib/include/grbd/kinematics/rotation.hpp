@@ -33,7 +33,9 @@ Vector3 body_motion(const Quaternion& P, const Vector3& r, const Vector3& rho);
 ///
 /// The unit quaternion p with R(p) = R and p0 ≥ 0, for a proper rotation
 /// matrix R (3 × 3). Robust at every angle, 0 and π included (Shepperd's method: divide by the
-/// largest of 4p0², 4p1², 4p2², 4p3², which are read off the diagonal of R).
+/// largest of 4p0², 4p1², 4p2², 4p3², which are read off the diagonal of R). Throws
+/// InvalidArgument unless is_rotation_matrix(R, 1e-6): a zero, scaled, reflecting or non-finite
+/// matrix has no quaternion (it used to come back as the identity).
 Quaternion quaternion_from_rotation_matrix(const Matrix3& R);
 // [from rotation matrix declaration]
 
