@@ -8,8 +8,9 @@
 
 #include <algorithm>
 #include <cmath>
-#include <string>
 #include <limits>
+#include <string>
+#include <vector>
 
 #include "grbd/contact/problem.hpp"
 #include "grbd/contact/prox.hpp"
@@ -90,20 +91,15 @@ double natural_map_residual(std::span<const Vector3> lambda, std::span<const Vec
   if (sum >= std::numeric_limits<double>::min() && sum <= std::numeric_limits<double>::max()) {
     return std::sqrt(sum);
   }
-  // The sum of squares overflowed or underflowed (or an entry is not finite): a second pass
-  // scaled by the largest component, as euclidean_norm() does.
-  double largest = 0.0;
+  // The sum of squares overflowed or underflowed (or an entry is not finite): euclidean_norm()
+  // rescales; the rare case alone pays for the copy.
+  std::vector<double> F;
+  F.reserve(3 * lambda.size());
   for (std::size_t i = 0; i < lambda.size(); ++i) {
-    const Vector3 F = natural_map(lambda[i], xi[i], mu[i]);
-    if (F.hasNaN()) return std::numeric_limits<double>::quiet_NaN();
-    largest = std::max(largest, F.cwiseAbs().maxCoeff());
+    const Vector3 F_i = natural_map(lambda[i], xi[i], mu[i]);
+    F.insert(F.end(), F_i.data(), F_i.data() + 3);
   }
-  if (largest == 0.0 || std::isinf(largest)) return largest;
-  double scaled = 0.0;
-  for (std::size_t i = 0; i < lambda.size(); ++i) {
-    scaled += (natural_map(lambda[i], xi[i], mu[i]) / largest).squaredNorm();
-  }
-  return largest * std::sqrt(scaled);
+  return euclidean_norm(F);
 }
 
 // [impact velocity]

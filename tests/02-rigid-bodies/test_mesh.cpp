@@ -37,6 +37,7 @@
 #include "grbd/body/triangle_mesh.hpp"
 #include "grbd/core/error.hpp"
 #include "grbd_test/random.hpp"
+#include "grbd_test/temp_dir.hpp"
 #include "grbd_test/worst_case.hpp"
 
 namespace {
@@ -53,41 +54,12 @@ using grbd::body::require_closed_oriented;
 using grbd::body::TriangleMesh;
 using grbd::body::write_obj;
 using grbd::test::describe;
+using grbd::test::TempDir;
 using grbd::test::WorstCase;
 
 constexpr double pi = std::numbers::pi;
 
 fs::path data_file(const char* name) { return fs::path(GRBD_TEST_DATA_DIR) / name; }
-
-/// A fresh directory for the files of one test, removed with everything in it at the end.
-class TempDir {
- public:
-  TempDir() {
-    std::random_device entropy;
-    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    path_ = fs::temp_directory_path() / ("grbd_" + std::string(info->test_suite_name()) + "_" +
-                                         info->name() + "_" + std::to_string(entropy()));
-    fs::create_directories(path_);
-  }
-  ~TempDir() {
-    std::error_code ignored;
-    fs::remove_all(path_, ignored);
-  }
-  TempDir(const TempDir&) = delete;
-  TempDir& operator=(const TempDir&) = delete;
-
-  /// Writes `content` byte for byte to the file `name` in this directory; returns its path.
-  fs::path write(const std::string& name, const std::string& content) const {
-    const fs::path file = path_ / name;
-    std::ofstream out(file, std::ios::binary | std::ios::trunc);
-    out.write(content.data(), static_cast<std::streamsize>(content.size()));
-    return file;
-  }
-  const fs::path& path() const { return path_; }
-
- private:
-  fs::path path_;
-};
 
 std::string read_text(const fs::path& file) {
   std::ifstream in(file, std::ios::binary);

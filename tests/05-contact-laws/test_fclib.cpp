@@ -42,7 +42,10 @@
 #include "grbd/contact/local_problem.hpp"
 #include "grbd/core/checks.hpp"
 #include "grbd/core/error.hpp"
+#include "grbd_test/hdf5.hpp"
 #include "grbd_test/random.hpp"
+#include "grbd_test/temp_dir.hpp"
+#include "grbd_test/watchdog.hpp"
 
 namespace {
 
@@ -53,6 +56,9 @@ using grbd::contact::BlockSparseMatrix;
 using grbd::contact::FclibKind;
 using grbd::contact::GlobalProblem;
 using grbd::contact::LocalProblem;
+using grbd::test::H5;
+using grbd::test::TempDir;
+using grbd::test::within;
 using SparseMatrix = Eigen::SparseMatrix<double>;
 
 constexpr const char* kPerioBox = "LMGC_100_PR_PerioBox-i00361-60-03000.hdf5";
@@ -63,28 +69,6 @@ constexpr const char* kSpheres = "Spheres-i099-356-679.hdf5";
 // Helpers: data files, temporary folders, messages.
 
 fs::path data_file(const char* name) { return fs::path(GRBD_FCLIB_DATA_DIR) / name; }
-
-// A fresh folder under the system's temporary folder, removed with everything in it.
-class TempDir {
- public:
-  TempDir() {
-    static std::atomic<int> counter{0};
-    std::random_device device;
-    path_ = fs::temp_directory_path() /
-            ("grbd-test-fclib-" + std::to_string(device()) + "-" + std::to_string(counter++));
-    fs::create_directories(path_);
-  }
-  ~TempDir() {
-    std::error_code ignored;
-    fs::remove_all(path_, ignored);
-  }
-  TempDir(const TempDir&) = delete;
-  TempDir& operator=(const TempDir&) = delete;
-  fs::path operator/(const std::string& name) const { return path_ / name; }
-
- private:
-  fs::path path_;
-};
 
 // A writable copy of the data file `name` in `dir`.
 fs::path writable_copy(const TempDir& dir, const char* name) {
@@ -123,24 +107,6 @@ std::string error_message(F&& f) {
 
 // ---------------------------------------------------------------------------------------------
 // Writing HDF5 with the C API.
-
-// An HDF5 identifier closed at the end of the scope.
-class H5 {
- public:
-  H5(hid_t id, herr_t (*close)(hid_t)) : id_(id), close_(close) {}
-  ~H5() {
-    if (id_ >= 0) close_(id_);
-  }
-  H5(H5&& other) noexcept : id_(std::exchange(other.id_, H5I_INVALID_HID)), close_(other.close_) {}
-  H5(const H5&) = delete;
-  H5& operator=(const H5&) = delete;
-  H5& operator=(H5&&) = delete;
-  hid_t get() const { return id_; }
-
- private:
-  hid_t id_;
-  herr_t (*close_)(hid_t);
-};
 
 // The number of HDF5 objects (files, groups, datasets, ...) open in the process.
 ssize_t open_hdf5_objects() { return H5Fget_obj_count(H5F_OBJ_ALL, H5F_OBJ_ALL); }
@@ -812,21 +778,6 @@ TEST(FclibReader, ReadsALocalProblemWrittenByTheTest) {
 // FclibReader: hostile files (issue 11, /work/shared/data/bad-inputs/README.md). Each case is
 // built here with the HDF5 C API; each must be refused with a grbd::Error naming the file and the
 // dataset, at once (well under a second), and never block.
-
-// Runs `f` and returns what it returns (or throws what it throws), but aborts the whole test
-// program with a message if `f` has not finished after `limit`: a reader that blocks, on a FIFO
-// for instance, must fail the tests rather than hang them.
-template <class F>
-auto within(std::chrono::seconds limit, const std::string& what, F&& f) {
-  auto future = std::async(std::launch::async, std::forward<F>(f));
-  if (future.wait_for(limit) != std::future_status::ready) {
-    std::fprintf(stderr, "FATAL: %s has not finished after %lld s: the FCLIB reader blocks\n",
-                 what.c_str(), static_cast<long long>(limit.count()));
-    std::fflush(stderr);
-    std::abort();
-  }
-  return future.get();
-}
 
 // The message of the grbd::Error that `read` throws (a failure if none or another), which must
 // come within `limit` seconds; the reader runs under a watchdog of 20 s.

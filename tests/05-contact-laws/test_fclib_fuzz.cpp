@@ -48,6 +48,8 @@
 #include "grbd/contact/fclib.hpp"
 #include "grbd/contact/local_problem.hpp"
 #include "grbd/core/error.hpp"
+#include "grbd_test/hdf5.hpp"
+#include "grbd_test/temp_dir.hpp"
 
 #if defined(__SANITIZE_ADDRESS__)
 #include <sanitizer/lsan_interface.h>
@@ -58,63 +60,9 @@ namespace {
 namespace fs = std::filesystem;
 using grbd::contact::GlobalProblem;
 using grbd::contact::LocalProblem;
-
-// A fresh folder under the system's temporary folder, removed with everything in it.
-class TempDir {
- public:
-  TempDir() {
-    static std::atomic<int> counter{0};
-    std::random_device device;
-    path_ = fs::temp_directory_path() /
-            ("grbd-test-fclib-fuzz-" + std::to_string(device()) + "-" + std::to_string(counter++));
-    fs::create_directories(path_);
-  }
-  ~TempDir() {
-    std::error_code ignored;
-    fs::remove_all(path_, ignored);
-  }
-  TempDir(const TempDir&) = delete;
-  TempDir& operator=(const TempDir&) = delete;
-  fs::path operator/(const std::string& name) const { return path_ / name; }
-
- private:
-  fs::path path_;
-};
-
-// An HDF5 identifier closed at the end of the scope.
-class H5 {
- public:
-  H5(hid_t id, herr_t (*close)(hid_t)) : id_(id), close_(close) {}
-  ~H5() {
-    if (id_ >= 0) close_(id_);
-  }
-  H5(H5&& other) noexcept : id_(other.id_), close_(other.close_) { other.id_ = H5I_INVALID_HID; }
-  H5(const H5&) = delete;
-  H5& operator=(const H5&) = delete;
-  H5& operator=(H5&&) = delete;
-  hid_t get() const { return id_; }
-
- private:
-  hid_t id_;
-  herr_t (*close_)(hid_t);
-};
-
-// Switches HDF5's error printing off for the edits of this test, which fail on purpose at times
-// (an edit of a damaged file, say).
-class Quiet {
- public:
-  Quiet() {
-    H5Eget_auto2(H5E_DEFAULT, &function_, &data_);
-    H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
-  }
-  ~Quiet() { H5Eset_auto2(H5E_DEFAULT, function_, data_); }
-  Quiet(const Quiet&) = delete;
-  Quiet& operator=(const Quiet&) = delete;
-
- private:
-  H5E_auto2_t function_ = nullptr;
-  void* data_ = nullptr;
-};
+using grbd::test::H5;
+using grbd::test::QuietHdf5;
+using grbd::test::TempDir;
 
 // Aborts the test program, naming the input, if a read has not finished after `limit`: a reader
 // that blocks or loops must fail the suite, not hang it. (stdout: the test captures stderr.)
@@ -704,7 +652,7 @@ TEST(FclibReader, NeverCrashesOnDamagedFiles) {
     for (int k = 0; k < kEdits; ++k) {
       fs::copy_file(valid, work, fs::copy_options::overwrite_existing);
       {
-        const Quiet quiet;
+        const QuietHdf5 quiet;  // the edits fail on purpose at times (an edit of a damaged file)
         const H5 file(H5Fopen(work.c_str(), H5F_ACC_RDWR, H5P_DEFAULT), H5Fclose);
         ASSERT_GE(file.get(), 0);
         const std::size_t edits = 1 + editor.index(3);

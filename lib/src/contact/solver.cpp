@@ -411,9 +411,18 @@ SolverResult run_apgd(Model& model, std::vector<Vector3>& lambda, const SolverOp
   double theta = 1.0;
   // The De Saxcé offset s_i = μ_i ‖ξ_T,i‖, frozen for a cycle of at most kCycle iterations.
   constexpr int kCycle = 25;
+  const auto offset = [&](std::size_t i, const Vector3& xi) {
+    return model.mu(i) * norm2d(xi(1), xi(2));
+  };
   std::vector<double> s(n);
-  for (std::size_t i = 0; i < n; ++i) s[i] = model.mu(i) * norm2d(xi_prev[i](1), xi_prev[i](2));
+  for (std::size_t i = 0; i < n; ++i) s[i] = offset(i, xi_prev[i]);
   int last_update = 0;
+  // Restart at iteration k: drop the momentum and take the offsets of the current iterate x.
+  const auto restart = [&](int k) {
+    theta = 1.0;
+    for (std::size_t i = 0; i < n; ++i) s[i] = offset(i, xi_x[i]);
+    last_update = k;
+  };
   bool frictional = false;
   for (std::size_t i = 0; i < n; ++i) frictional = frictional || model.mu(i) > 0.0;
   for (int k = 1;; ++k) {  // stops at max_iterations at the end of the body, as run_sor
@@ -470,9 +479,7 @@ SolverResult run_apgd(Model& model, std::vector<Vector3>& lambda, const SolverOp
       // Restart, and take the cone offset s = μ ‖ξ_T‖ of the current iterate: each cycle solves
       // the convex problem with a fixed s (Anitescu's relaxation shifted by s), whose fixed point
       // over the cycles is Coulomb's law.
-      theta = 1.0;
-      for (std::size_t i = 0; i < n; ++i) s[i] = model.mu(i) * norm2d(xi_x[i](1), xi_x[i](2));
-      last_update = k;
+      restart(k);
     } else {
       const double theta_next = 0.5 * (-theta * theta + theta * std::sqrt(theta * theta + 4.0));
       beta = theta * (1.0 - theta) / (theta * theta + theta_next);
@@ -494,16 +501,14 @@ SolverResult run_apgd(Model& model, std::vector<Vector3>& lambda, const SolverOp
       // also the offset μ ‖ξ_T‖ of the iterate itself. Otherwise refresh s, restart and go on.
       bool consistent = true;
       for (std::size_t i = 0; i < n && consistent; ++i) {
-        const double s_now = model.mu(i) * norm2d(xi_x[i](1), xi_x[i](2));
+        const double s_now = offset(i, xi_x[i]);
         consistent = std::abs(s_now - s[i]) <= options.abs_tol + options.rel_tol * s_now;
       }
       if (consistent) break;
       result.converged = false;
-      theta = 1.0;
-      for (std::size_t i = 0; i < n; ++i) s[i] = model.mu(i) * norm2d(xi_x[i](1), xi_x[i](2));
+      restart(k);
       y = lambda;
       xi_y = xi_x;
-      last_update = k;
     }
     if (k == options.max_iterations) break;
   }
