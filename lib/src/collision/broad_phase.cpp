@@ -196,10 +196,10 @@ void CellGrid::find_pairs(std::vector<IndexPair>& pairs) const {
   // is one contiguous range of balls_. The ranges are gathered into one short array `near`,
   // the cell's own balls first, so that each ball of the cell runs a single loop (few
   // mispredicted loop exits), and every test writes its pair unconditionally to `pairs`, kept
-  // long enough, and keeps it only on a hit (no unpredictable branch). `near` is allocated once
-  // per call, never per pair.
-  std::vector<Ball> near;
-  std::vector<std::int32_t> near_index;
+  // long enough, and keeps it only on a hit (no unpredictable branch). `near` is a member that
+  // keeps its capacity: after the first call, finding pairs allocates nothing (chapter 6).
+  std::vector<Ball>& near = near_;
+  std::vector<std::int32_t>& near_index = near_index_;
   std::size_t count = 0;
   const auto gather = [&](std::int32_t begin, std::int32_t end) {
     near.insert(near.end(), balls + begin, balls + end);

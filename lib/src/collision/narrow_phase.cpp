@@ -7,6 +7,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <string>
+
+#include "grbd/collision/static_mesh.hpp"
+#include "grbd/core/error.hpp"
 
 namespace grbd::collision {
 
@@ -128,5 +132,40 @@ void capsule_half_space(const Capsule& capsule, const Placement& capsule_placeme
     out.push_back(contact);
   }
 }
+
+// [collide]
+void collide(const Shape& a, const Placement& pa, const Shape& b, const Placement& pb,
+             double margin, std::vector<ContactGeometry>& out) {
+  if (const auto* sphere = std::get_if<Sphere>(&a)) {
+    if (const auto* other = std::get_if<Sphere>(&b)) {
+      out.push_back(sphere_sphere(pa.I_r, sphere->radius, pb.I_r, other->radius));
+    } else if (const auto* box = std::get_if<Box>(&b)) {
+      out.push_back(sphere_box(pa.I_r, sphere->radius, *box, pb));
+    } else if (const auto* capsule = std::get_if<Capsule>(&b)) {
+      out.push_back(sphere_capsule(pa.I_r, sphere->radius, *capsule, pb));
+    } else if (const auto* half_space = std::get_if<HalfSpace>(&b)) {
+      out.push_back(sphere_half_space(pa.I_r, sphere->radius, *half_space));
+    } else {
+      sphere_mesh(pa.I_r, sphere->radius, *std::get<std::shared_ptr<const StaticMesh>>(b), margin,
+                  out);
+    }
+    return;
+  }
+  if (const auto* half_space = std::get_if<HalfSpace>(&b)) {
+    if (const auto* box = std::get_if<Box>(&a)) {
+      box_half_space(*box, pa, *half_space, margin, out);
+      return;
+    }
+    if (const auto* capsule = std::get_if<Capsule>(&a)) {
+      capsule_half_space(*capsule, pa, *half_space, margin, out);
+      return;
+    }
+  }
+  throw InvalidArgument("collide: the pair " + std::string(kind_name(kind(a))) + "–" +
+                        std::string(kind_name(kind(b))) +
+                        " is not supported in this order (supported pairs: sphere first with "
+                        "any shape; box or capsule first with a half-space)");
+}
+// [collide]
 
 }  // namespace grbd::collision

@@ -3,7 +3,13 @@
 
 #include "grbd/collision/shapes.hpp"
 
+#include <cmath>
+#include <memory>
+#include <string>
 #include <type_traits>
+
+#include "grbd/core/checks.hpp"
+#include "grbd/core/error.hpp"
 
 namespace grbd::collision {
 
@@ -40,6 +46,57 @@ std::string_view kind_name(ShapeKind kind) {
       return "mesh";
   }
   return "unknown";
+}
+
+double bounding_radius(const Shape& shape) {
+  if (const auto* sphere = std::get_if<Sphere>(&shape)) return sphere->radius;
+  if (const auto* box = std::get_if<Box>(&shape)) return box->half_extents.norm();
+  if (const auto* capsule = std::get_if<Capsule>(&shape)) {
+    return capsule->radius + capsule->half_length;
+  }
+  return 0.0;
+}
+
+void normalize_and_check(Shape& shape, std::string_view where_view) {
+  const std::string where(where_view);
+  switch (kind(shape)) {
+    case ShapeKind::sphere:
+      require_positive_finite(where, "sphere radius", std::get<Sphere>(shape).radius);
+      break;
+    case ShapeKind::box: {
+      const Vector3& h = std::get<Box>(shape).half_extents;
+      for (int i = 0; i < 3; ++i) require_positive_finite(where, "box half extent", h[i]);
+      break;
+    }
+    case ShapeKind::capsule: {
+      const Capsule& capsule = std::get<Capsule>(shape);
+      require_positive_finite(where, "capsule radius", capsule.radius);
+      if (!(capsule.half_length >= 0.0 && std::isfinite(capsule.half_length))) {
+        throw InvalidArgument(where + ": expected a finite capsule half length ≥ 0, found " +
+                              format_number(capsule.half_length));
+      }
+      break;
+    }
+    case ShapeKind::half_space: {
+      HalfSpace& half_space = std::get<HalfSpace>(shape);
+      const double norm = half_space.I_n.norm();
+      if (!(norm > 0.0 && std::isfinite(norm) && std::isfinite(half_space.offset))) {
+        throw InvalidArgument(where +
+                              ": expected a finite non-zero half-space normal and a "
+                              "finite offset, found |I_n| = " +
+                              format_number(norm) + ", offset " + format_number(half_space.offset));
+      }
+      // The same plane with a unit normal.
+      half_space.I_n /= norm;
+      half_space.offset /= norm;
+      break;
+    }
+    case ShapeKind::mesh:
+      if (!std::get<std::shared_ptr<const StaticMesh>>(shape)) {
+        throw InvalidArgument(where + ": expected a mesh, found a null pointer");
+      }
+      break;
+  }
 }
 
 }  // namespace grbd::collision

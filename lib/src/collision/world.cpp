@@ -30,16 +30,6 @@ std::string describe(std::int32_t index, const Collider& collider) {
   return text + ")";
 }
 
-// The radius of a sphere about the shape's origin that holds the shape (moving shapes only).
-double bounding_radius(const Shape& shape) {
-  if (const auto* sphere = std::get_if<Sphere>(&shape)) return sphere->radius;
-  if (const auto* box = std::get_if<Box>(&shape)) return box->half_extents.norm();
-  if (const auto* capsule = std::get_if<Capsule>(&shape)) {
-    return capsule->radius + capsule->half_length;
-  }
-  return 0.0;
-}
-
 bool same_body(const Collider& a, const Collider& b) {
   return a.body != kStatic && a.body == b.body;
 }
@@ -52,6 +42,13 @@ bool supported(ShapeKind a, ShapeKind b) {
   return b == ShapeKind::half_space && (a == ShapeKind::box || a == ShapeKind::capsule);
 }
 
+void CollisionWorld::clear() {
+  colliders_.clear();
+  representatives_.fill(Representatives{});
+}
+
+void CollisionWorld::reserve(std::size_t colliders) { colliders_.reserve(colliders); }
+
 std::int32_t CollisionWorld::add(Collider collider) {
   const auto index = static_cast<std::int32_t>(colliders_.size());
   const std::string where = "CollisionWorld::add (collider " + std::to_string(index) + ")";
@@ -63,62 +60,50 @@ std::int32_t CollisionWorld::add(Collider collider) {
     throw InvalidArgument(where + ": expected a finite K_r_KC and a rotation matrix A_KC");
   }
   const ShapeKind shape_kind = kind(collider.shape);
-  switch (shape_kind) {
-    case ShapeKind::sphere:
-      require_positive_finite(where, "sphere radius", std::get<Sphere>(collider.shape).radius);
-      break;
-    case ShapeKind::box: {
-      const Vector3& h = std::get<Box>(collider.shape).half_extents;
-      for (int i = 0; i < 3; ++i) require_positive_finite(where, "box half extent", h[i]);
-      break;
-    }
-    case ShapeKind::capsule: {
-      const Capsule& capsule = std::get<Capsule>(collider.shape);
-      require_positive_finite(where, "capsule radius", capsule.radius);
-      if (!(capsule.half_length >= 0.0 && std::isfinite(capsule.half_length))) {
-        throw InvalidArgument(where + ": expected a finite capsule half length ≥ 0, found " +
-                              format_number(capsule.half_length));
-      }
-      break;
-    }
-    case ShapeKind::half_space: {
-      HalfSpace& half_space = std::get<HalfSpace>(collider.shape);
-      const double norm = half_space.I_n.norm();
-      if (!(norm > 0.0 && std::isfinite(norm) && std::isfinite(half_space.offset))) {
-        throw InvalidArgument(where +
-                              ": expected a finite non-zero half-space normal and a "
-                              "finite offset, found |I_n| = " +
-                              format_number(norm) + ", offset " + format_number(half_space.offset));
-      }
-      // The same plane with a unit normal.
-      half_space.I_n /= norm;
-      half_space.offset /= norm;
-      break;
-    }
-    case ShapeKind::mesh:
-      if (!std::get<std::shared_ptr<const StaticMesh>>(collider.shape)) {
-        throw InvalidArgument(where + ": expected a mesh, found a null pointer");
-      }
-      break;
-  }
+  normalize_and_check(collider.shape, where);
   if ((shape_kind == ShapeKind::half_space || shape_kind == ShapeKind::mesh) &&
       collider.body != kStatic) {
     throw InvalidArgument(where + ": a " + std::string(kind_name(shape_kind)) +
                           " is static only, found it attached to body " +
                           std::to_string(collider.body));
   }
-  for (std::int32_t j = 0; j < index; ++j) {
-    const Collider& other = colliders_[static_cast<std::size_t>(j)];
-    if (collider.body == kStatic && other.body == kStatic) continue;  // never touch
-    if (same_body(collider, other)) continue;                         // parts of one body
-    const ShapeKind other_kind = kind(other.shape);
-    if (!supported(shape_kind, other_kind)) {
-      throw InvalidArgument("CollisionWorld::add: " + describe(index, collider) + " cannot meet " +
-                            describe(j, other) + ": the pair " +
-                            std::string(kind_name(shape_kind)) + "–" +
-                            std::string(kind_name(other_kind)) +
-                            " is not supported; supported pairs: " + std::string(kSupportedPairs));
+  // The pair check in O(1): the first collider that cannot meet this one is, for each kind,
+  // the first static collider of that kind or the first moving one on another body, and
+  // representatives_ keeps exactly those (the first moving collider of a kind, and the first
+  // one on a different body from it). A scene of 10⁶ spheres is assembled in O(N).
+  const bool is_static = collider.body == kStatic;
+  std::int32_t conflict = -1;
+  const auto consider = [&](std::int32_t j) {
+    if (j >= 0 && (conflict < 0 || j < conflict)) conflict = j;
+  };
+  for (int k = 0; k < kShapeKinds; ++k) {
+    if (supported(shape_kind, static_cast<ShapeKind>(k))) continue;
+    const Representatives& r = representatives_[static_cast<std::size_t>(k)];
+    if (!is_static) consider(r.first_static);  // two static colliders never touch
+    if (r.first_moving < 0) continue;
+    if (is_static || colliders_[static_cast<std::size_t>(r.first_moving)].body != collider.body) {
+      consider(r.first_moving);
+    } else {
+      consider(r.first_moving_other_body);  // parts of one body never touch
     }
+  }
+  if (conflict >= 0) {
+    const Collider& other = colliders_[static_cast<std::size_t>(conflict)];
+    const ShapeKind other_kind = kind(other.shape);
+    throw InvalidArgument("CollisionWorld::add: " + describe(index, collider) + " cannot meet " +
+                          describe(conflict, other) + ": the pair " +
+                          std::string(kind_name(shape_kind)) + "–" +
+                          std::string(kind_name(other_kind)) +
+                          " is not supported; supported pairs: " + std::string(kSupportedPairs));
+  }
+  Representatives& mine = representatives_[static_cast<std::size_t>(shape_kind)];
+  if (is_static) {
+    if (mine.first_static < 0) mine.first_static = index;
+  } else if (mine.first_moving < 0) {
+    mine.first_moving = index;
+  } else if (mine.first_moving_other_body < 0 &&
+             colliders_[static_cast<std::size_t>(mine.first_moving)].body != collider.body) {
+    mine.first_moving_other_body = index;
   }
   colliders_.push_back(std::move(collider));
   return index;
@@ -133,13 +118,17 @@ void CollisionWorld::detect(std::span<const body::State> states, double margin,
                           format_number(margin));
   }
   const std::size_t n = colliders_.size();
-  // World placement of every collider: I_r = I_r_S + A_IK K_r_KC, A_IC = A_IK A_KC.
-  std::vector<Placement> placements(n);
-  std::vector<Matrix3> A_IK(n, Matrix3::Identity());
+  // World placement of every collider: I_r = I_r_S + A_IK K_r_KC, A_IC = A_IK A_KC. The buffers
+  // are members: after the first call, detection allocates nothing but the contacts that grow.
+  placements_.resize(n);
+  A_IK_.resize(n);
+  std::vector<Placement>& placements = placements_;
+  std::vector<Matrix3>& A_IK = A_IK_;
   for (std::size_t i = 0; i < n; ++i) {
     const Collider& collider = colliders_[i];
     if (collider.body == kStatic) {
       placements[i] = {collider.K_r_KC, collider.A_KC};
+      A_IK[i].setIdentity();
       continue;
     }
     if (static_cast<std::size_t>(collider.body) >= states.size()) {
@@ -183,7 +172,7 @@ void CollisionWorld::detect(std::span<const body::State> states, double margin,
 
   // The narrow phase of one pair, in the argument order of the kernels (the sphere first, the
   // half-space last).
-  std::vector<ContactGeometry> found;
+  std::vector<ContactGeometry>& found = found_;
   const auto narrow = [&](std::size_t i, std::size_t j) {
     if (kind(colliders_[j].shape) < kind(colliders_[i].shape)) std::swap(i, j);
     const Shape& si = colliders_[i].shape;
@@ -191,24 +180,7 @@ void CollisionWorld::detect(std::span<const body::State> states, double margin,
     const Placement& pi = placements[i];
     const Placement& pj = placements[j];
     found.clear();
-    if (const auto* sphere = std::get_if<Sphere>(&si)) {
-      if (const auto* other = std::get_if<Sphere>(&sj)) {
-        found.push_back(sphere_sphere(pi.I_r, sphere->radius, pj.I_r, other->radius));
-      } else if (const auto* box = std::get_if<Box>(&sj)) {
-        found.push_back(sphere_box(pi.I_r, sphere->radius, *box, pj));
-      } else if (const auto* capsule = std::get_if<Capsule>(&sj)) {
-        found.push_back(sphere_capsule(pi.I_r, sphere->radius, *capsule, pj));
-      } else if (const auto* half_space = std::get_if<HalfSpace>(&sj)) {
-        found.push_back(sphere_half_space(pi.I_r, sphere->radius, *half_space));
-      } else {
-        sphere_mesh(pi.I_r, sphere->radius, *std::get<std::shared_ptr<const StaticMesh>>(sj),
-                    margin, found);
-      }
-    } else if (const auto* box = std::get_if<Box>(&si)) {
-      box_half_space(*box, pi, std::get<HalfSpace>(sj), margin, found);
-    } else {
-      capsule_half_space(std::get<Capsule>(si), pi, std::get<HalfSpace>(sj), margin, found);
-    }
+    collide(si, pi, sj, pj, margin, found);
     for (const ContactGeometry& geometry : found) {
       if (geometry.g_N <= margin) emit(i, j, geometry);
     }

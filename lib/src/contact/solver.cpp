@@ -1,17 +1,24 @@
 /// \file
 /// \brief JOR, SOR and APGD for the body form and the local form of the contact problem.
 ///
-/// The three methods are written once, over a small "model" that knows how to evaluate the
-/// contact velocities ξ(Λ) of one form and how to do a Gauss–Seidel sweep in it: BodyModel keeps
-/// the body velocities u in step with Λ (u = u_free + M⁻¹ W Λ), LocalModel reads block rows of W.
+/// One driver (iterate()) runs the loop of all three methods; each method is a policy with one
+/// iteration, the synchronisation of u for the hook, the acceptance of a met criterion (APGD's
+/// cone-offset check) and the end. The policies are written once, over a small "model" that
+/// knows how to evaluate the contact velocities ξ(Λ) of one form and how to do a Gauss–Seidel
+/// sweep in it: BodyModel keeps the body velocities u in step with Λ (u = u_free + M⁻¹ W Λ),
+/// LocalModel reads block rows of W. Every buffer lives in a Workspace that keeps its capacity
+/// between solves (ContactSolver), so that a repeated solve allocates nothing.
 
 #include "grbd/contact/solver.hpp"
 
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
+#include <limits>
 #include <string>
+#include <utility>
 
 #include "grbd/contact/prox.hpp"
 #include "grbd/core/checks.hpp"
@@ -20,7 +27,26 @@
 
 namespace grbd::contact {
 
+/// The buffers of every solve, kept between solves by ContactSolver. Each is resized (never
+/// shrunk) to the problem at hand; vector::assign and resize reuse the capacity.
+struct detail::SolverWorkspace {
+  std::vector<Matrix3> G;             ///< body form: G_ii, computed by ContactSolver::solve()
+  std::vector<RFactors> r;            ///< r-factors of JOR and SOR
+  std::vector<double> mu;             ///< μ_i, for the natural map
+  std::vector<Vector3> xi;            ///< ξ of the monitor (‖c‖, residual)
+  std::vector<Vector3> lambda_old;    ///< Λ before the iteration (percussion criterion)
+  std::vector<double> velocity_old;   ///< u or ξ before the iteration (velocity criterion)
+  std::vector<Vector6> v;             ///< body form: scratch body velocities
+  std::vector<Vector3> seen;          ///< local form: ξ of the last iteration
+  std::vector<Vector3> jor_xi;        ///< JOR: ξ of the old iterate
+  std::vector<Vector3> x_prev, y, xi_x, xi_prev, xi_y;  ///< APGD iterates and their ξ
+  std::vector<double> s;              ///< APGD: cone offsets
+  std::vector<Vector3> power_x, power_y;  ///< power iteration
+};
+
 namespace {
+
+using Workspace = detail::SolverWorkspace;
 
 std::span<const double> flat(std::span<const Vector3> v) {
   return {v.empty() ? nullptr : v.data()->data(), 3 * v.size()};
@@ -39,10 +65,34 @@ bool all_finite(std::span<const Vector3> v) {
   return true;
 }
 
+/// natural_map_residual() without its allocation in the rare cases: the same sum in the same
+/// order, so the same result; an exactly zero F (a solve that ends on the exact solution) is 0
+/// here, and only a sum that over- or underflows is handed to natural_map_residual(), which
+/// rescales.
+double residual_norm(std::span<const Vector3> lambda, std::span<const Vector3> xi,
+                     std::span<const double> mu) {
+  double sum = 0.0;
+  for (std::size_t i = 0; i < lambda.size(); ++i) {
+    sum += natural_map(lambda[i], xi[i], mu[i]).squaredNorm();
+  }
+  if (sum >= std::numeric_limits<double>::min() && sum <= std::numeric_limits<double>::max()) {
+    return std::sqrt(sum);
+  }
+  if (sum == 0.0) {
+    bool zero = true;
+    for (std::size_t i = 0; i < lambda.size() && zero; ++i) {
+      zero = natural_map(lambda[i], xi[i], mu[i]).isZero(0.0);
+    }
+    if (zero) return 0.0;
+  }
+  return natural_map_residual(lambda, xi, mu);
+}
+
+/// Refuses bad options; builds a message (and allocates) only when it throws.
 void validate_options(const SolverOptions& o, const char* solver) {
-  const std::string where = std::string(solver) + ": ";
+  const auto where = [&] { return std::string(solver) + ": "; };
   if (o.min_iterations < 0 || o.max_iterations < 1 || o.max_iterations < o.min_iterations) {
-    throw InvalidArgument(where +
+    throw InvalidArgument(where() +
                           "expected 0 <= min_iterations <= max_iterations and "
                           "max_iterations >= 1; found min_iterations = " +
                           std::to_string(o.min_iterations) +
@@ -50,18 +100,18 @@ void validate_options(const SolverOptions& o, const char* solver) {
   }
   if (!(o.abs_tol >= 0.0) || !(o.rel_tol >= 0.0) || !std::isfinite(o.abs_tol) ||
       !std::isfinite(o.rel_tol)) {
-    throw InvalidArgument(where + "expected finite tolerances >= 0; found abs_tol = " +
+    throw InvalidArgument(where() + "expected finite tolerances >= 0; found abs_tol = " +
                           format_number(o.abs_tol) + ", rel_tol = " + format_number(o.rel_tol));
   }
   if (!(o.alpha > 0.0 && o.alpha < 2.0)) {
-    throw InvalidArgument(where + "expected the relaxation alpha in (0, 2); found " +
+    throw InvalidArgument(where() + "expected the relaxation alpha in (0, 2); found " +
                           format_number(o.alpha));
   }
   // An enum holds any value of its underlying type: a cast or a corrupted options struct would
   // otherwise fall through every switch.
   const auto refuse_enum = [&](const char* name, int value, const char* expected) {
-    throw InvalidArgument(where + "expected " + name + " to be one of " + expected + "; found " +
-                          "the value " + std::to_string(value));
+    throw InvalidArgument(where() + "expected " + name + " to be one of " + expected +
+                          "; found the value " + std::to_string(value));
   };
   switch (o.criterion) {
     case Criterion::percussion_change:
@@ -75,9 +125,12 @@ void validate_options(const SolverOptions& o, const char* solver) {
   switch (o.r_strategy) {
     case RFactorStrategy::per_contact:
     case RFactorStrategy::global:
+    case RFactorStrategy::spectral:
+    case RFactorStrategy::automatic:
       break;
     default:
-      refuse_enum("r_strategy", static_cast<int>(o.r_strategy), "per_contact, global");
+      refuse_enum("r_strategy", static_cast<int>(o.r_strategy),
+                  "per_contact, global, spectral, automatic");
   }
   switch (o.form) {
     case ProxForm::alart_curnier:
@@ -86,6 +139,24 @@ void validate_options(const SolverOptions& o, const char* solver) {
     default:
       refuse_enum("form", static_cast<int>(o.form), "alart_curnier, de_saxce");
   }
+}
+
+void validate_method(Method method, const char* where) {
+  switch (method) {
+    case Method::sor:
+    case Method::jor:
+    case Method::apgd:
+      return;
+  }
+  throw InvalidArgument(std::string(where) +
+                        ": expected the method to be one of sor, jor, apgd; found the value " +
+                        std::to_string(static_cast<int>(method)));
+}
+
+/// `automatic` made concrete for `method`.
+RFactorStrategy resolve(RFactorStrategy strategy, Method method) {
+  if (strategy != RFactorStrategy::automatic) return strategy;
+  return method == Method::jor ? RFactorStrategy::spectral : RFactorStrategy::per_contact;
 }
 
 void prepare_guess(std::vector<Vector3>& lambda, std::size_t n, const char* solver) {
@@ -112,24 +183,34 @@ Vector3 prox_update(ProxForm form, const Vector3& lambda, const Vector3& xi, con
                                          : de_saxce_update(lambda, xi, std::min(r.r_N, r.r_T), mu);
 }
 
-/// The body form: Λ and the body velocities that go with it.
+/// The body form: Λ and the body velocities u that go with it (the caller's ContactSolution).
 class BodyModel {
  public:
-  BodyModel(const ContactProblem& problem, std::vector<Vector3>& lambda)
-      : problem_(problem), lambda_(lambda) {}
+  BodyModel(const ContactProblem& problem, std::span<const Matrix3> G, std::span<Vector3> lambda,
+            std::vector<Vector6>& u, Workspace& ws)
+      : problem_(problem), G_(G), lambda_(lambda), u_(u), ws_(ws) {}
 
   std::size_t size() const { return problem_.contacts.size(); }
   double mu(std::size_t i) const { return problem_.contacts[i].mu; }
-  Matrix3 delassus(std::size_t i) const {
-    return delassus_block(problem_.contacts[i], problem_.M_inv);
+  const Matrix3& delassus(std::size_t i) const { return G_[i]; }
+  std::span<Vector3> lambda() const { return lambda_; }
+  std::span<Vector6> u() const { return u_; }
+
+  /// ξ(Λ) for the given percussions (not necessarily the model's own): the same operations as
+  /// contact_velocities(problem, velocities_from_percussions(problem, Λ)), into the workspace.
+  void velocities(std::span<const Vector3> lambda, std::vector<Vector3>& xi) {
+    body_velocities(lambda, ws_.v);
+    contact_velocities_of(ws_.v, xi);
   }
-  /// ξ(Λ) for the given percussions (not necessarily the model's own).
-  void velocities(std::span<const Vector3> lambda, std::vector<Vector3>& xi) const {
-    xi = contact_velocities(problem_, velocities_from_percussions(problem_, lambda));
+  /// ξ(0) = c, the free contact velocities.
+  void free_velocities(std::vector<Vector3>& xi) {
+    ws_.v.assign(problem_.u_free.begin(), problem_.u_free.end());
+    contact_velocities_of(ws_.v, xi);
   }
   /// y = G x = Wᵀ M⁻¹ W x, the linear part of ξ(Λ), without u_free or restitution.
-  void apply_G(std::span<const Vector3> x, std::vector<Vector3>& y) const {
-    std::vector<Vector6> v(problem_.M_inv.size(), Vector6::Zero());
+  void apply_G(std::span<const Vector3> x, std::vector<Vector3>& y) {
+    std::vector<Vector6>& v = ws_.v;
+    v.assign(problem_.M_inv.size(), Vector6::Zero());
     for (std::size_t i = 0; i < size(); ++i) {
       const ContactConstraint& c = problem_.contacts[i];
       if (c.body_a != kStatic) v[c.body_a] += problem_.M_inv[c.body_a].apply(c.W_a * x[i]);
@@ -143,7 +224,9 @@ class BodyModel {
     }
   }
   /// Makes u consistent with Λ.
-  void synchronize() { u = velocities_from_percussions(problem_, lambda_); }
+  void synchronize() { body_velocities(lambda_, u_); }
+  /// Brings the body velocities u of the hook up to date with Λ.
+  void update_u() { synchronize(); }
   /// After JOR or APGD changed all of Λ at once: u follows Λ only when the velocity criterion
   /// reads it, and once more at the end (done()), instead of a full pass every iteration.
   void record(const std::vector<Vector3>& /*xi*/, bool velocity_watched) {
@@ -152,40 +235,72 @@ class BodyModel {
   /// Brings u up to date with the returned Λ.
   void done() { synchronize(); }
   void sor_sweep(std::span<const RFactors> r, ProxForm form) {
-    contact::sor_sweep(problem_, r, form, u, lambda_);
+    contact::sor_sweep(problem_, r, form, u_, lambda_);
   }
   /// What the velocity criterion watches.
-  std::span<const double> watched_velocity() const { return flat(std::span<const Vector6>(u)); }
-
-  std::vector<Vector6> u;
+  std::span<const double> watched_velocity() const { return flat(std::span<const Vector6>(u_)); }
 
  private:
+  /// u = u_free + M⁻¹ W Λ, as velocities_from_percussions() computes it.
+  void body_velocities(std::span<const Vector3> lambda, std::vector<Vector6>& u) const {
+    u.assign(problem_.u_free.begin(), problem_.u_free.end());
+    for (std::size_t i = 0; i < lambda.size(); ++i) {
+      const ContactConstraint& c = problem_.contacts[i];
+      if (c.body_a != kStatic) u[c.body_a] += problem_.M_inv[c.body_a].apply(c.W_a * lambda[i]);
+      if (c.body_b != kStatic) u[c.body_b] -= problem_.M_inv[c.body_b].apply(c.W_b * lambda[i]);
+    }
+  }
+  /// ξ_i = W_iᵀ u + ε_i ∘ γ_A,i, as contact_velocities() computes it.
+  void contact_velocities_of(std::span<const Vector6> u, std::vector<Vector3>& xi) const {
+    xi.resize(size());
+    for (std::size_t i = 0; i < xi.size(); ++i) {
+      const ContactConstraint& c = problem_.contacts[i];
+      Vector3 gamma = Vector3::Zero();
+      if (c.body_a != kStatic) gamma += c.W_a.transpose() * u[c.body_a];
+      if (c.body_b != kStatic) gamma -= c.W_b.transpose() * u[c.body_b];
+      xi[i] = impact_velocity(gamma, c.gamma_A, c.eps_N, c.eps_T);
+    }
+  }
+
   const ContactProblem& problem_;
-  std::vector<Vector3>& lambda_;
+  std::span<const Matrix3> G_;
+  std::span<Vector3> lambda_;
+  std::vector<Vector6>& u_;
+  Workspace& ws_;
 };
 
 /// The local form ξ = W Λ + q.
 class LocalModel {
  public:
-  LocalModel(const LocalProblem& problem, std::vector<Vector3>& lambda)
-      : problem_(problem), lambda_(lambda) {}
+  LocalModel(const LocalProblem& problem, std::span<Vector3> lambda, Workspace& ws)
+      : problem_(problem), lambda_(lambda), ws_(ws) {}
 
   std::size_t size() const { return problem_.q.size(); }
   double mu(std::size_t i) const { return problem_.mu[i]; }
-  Matrix3 delassus(std::size_t i) const {
+  const Matrix3& delassus(std::size_t i) const {
     return problem_.W.blocks[static_cast<std::size_t>(problem_.W.diagonal[i])];
   }
+  std::span<Vector3> lambda() const { return lambda_; }
+  /// No body velocities in the local form.
+  std::span<Vector6> u() const { return {}; }
+
   void velocities(std::span<const Vector3> lambda, std::vector<Vector3>& xi) const {
     xi.resize(size());
     multiply(problem_.W, lambda, xi);
     for (std::size_t i = 0; i < xi.size(); ++i) xi[i] += problem_.q[i];
+  }
+  /// ξ(0) = q.
+  void free_velocities(std::vector<Vector3>& xi) const {
+    xi.assign(problem_.q.begin(), problem_.q.end());
   }
   /// y = W x, the linear part of ξ(Λ).
   void apply_G(std::span<const Vector3> x, std::vector<Vector3>& y) const {
     y.resize(size());
     multiply(problem_.W, x, y);
   }
-  void synchronize() { seen_.assign(size(), Vector3::Zero()); }
+  void synchronize() { ws_.seen.assign(size(), Vector3::Zero()); }
+  /// No body velocities to bring up to date.
+  void update_u() {}
   void sor_sweep(std::span<const RFactors> r, ProxForm form) {
     const BlockSparseMatrix& W = problem_.W;
     for (std::size_t i = 0; i < size(); ++i) {
@@ -193,191 +308,57 @@ class LocalModel {
       for (std::int64_t k = W.row_start[i]; k < W.row_start[i + 1]; ++k) {
         xi.noalias() += W.blocks[k] * lambda_[W.column[k]];
       }
-      seen_[i] = xi;
+      ws_.seen[i] = xi;
       lambda_[i] = prox_update(form, lambda_[i], xi, r[i], problem_.mu[i]);
     }
   }
-  std::span<const double> watched_velocity() const { return flat(std::span<const Vector3>(seen_)); }
+  std::span<const double> watched_velocity() const {
+    return flat(std::span<const Vector3>(ws_.seen));
+  }
   /// After JOR or APGD changed all of Λ at once: keeps the velocities ξ of the iteration for the
   /// velocity criterion.
   void record(const std::vector<Vector3>& xi, bool velocity_watched) {
-    if (velocity_watched) seen_ = xi;
+    if (velocity_watched) ws_.seen.assign(xi.begin(), xi.end());
   }
   /// Nothing to bring up to date: the local form has no body velocities.
   void done() {}
 
  private:
   const LocalProblem& problem_;
-  std::vector<Vector3>& lambda_;
-  std::vector<Vector3> seen_;
+  std::span<Vector3> lambda_;
+  Workspace& ws_;
 };
 
-template <class Model>
-std::vector<RFactors> model_r_factors(const Model& model, RFactorStrategy strategy, double alpha) {
-  std::vector<RFactors> r(model.size());
-  if (strategy == RFactorStrategy::per_contact) {
-    for (std::size_t i = 0; i < r.size(); ++i) r[i] = r_factors(model.delassus(i), alpha);
-    return r;
-  }
-  double largest = 0.0;
-  for (std::size_t i = 0; i < r.size(); ++i) {
-    largest = std::max(largest, model.delassus(i).diagonal().maxCoeff());
-  }
-  std::fill(r.begin(), r.end(), RFactors{alpha / largest, alpha / largest});
-  return r;
-}
-
-/// The stopping test and the bookkeeping shared by the three methods.
-template <class Model>
-class Monitor {
- public:
-  Monitor(const Model& model, const SolverOptions& options, std::vector<Vector3>& lambda,
-          SolverResult& result)
-      : model_(model), options_(options), lambda_(lambda), result_(result) {
-    std::vector<Vector3> zero(model.size(), Vector3::Zero());
-    model.velocities(zero, xi_);
-    result_.norm_c = norm(xi_);
-    mu_.resize(model.size());
-    for (std::size_t i = 0; i < mu_.size(); ++i) mu_[i] = model.mu(i);
-  }
-
-  /// Call before an iteration changes Λ.
-  void before() {
-    if (options_.criterion == Criterion::percussion_change) lambda_old_ = lambda_;
-    if (options_.criterion == Criterion::velocity_change) {
-      const auto v = model_.watched_velocity();
-      velocity_old_.assign(v.begin(), v.end());
-    }
-  }
-
-  /// Call after iteration k (1-based) with the model up to date; true to stop: the criterion
-  /// is met (from min_iterations on), or an iterate is not finite (divergence: stop at once,
-  /// whatever max_iterations says).
-  bool after(int k) {
-    result_.iterations = k;
-    if (!all_finite(lambda_)) {
-      result_.diverged = true;
-      return true;
-    }
-    double residual = -1.0;
-    if (options_.record_history || options_.criterion == Criterion::natural_residual) {
-      residual = natural_residual();
-      if (options_.record_history) result_.history.push_back(residual);
-    }
-    bool met = false;
-    switch (options_.criterion) {
-      case Criterion::percussion_change:
-        met = has_converged(flat(std::span<const Vector3>(lambda_old_)),
-                            flat(std::span<const Vector3>(lambda_)), options_.abs_tol,
-                            options_.rel_tol);
-        break;
-      case Criterion::velocity_change: {
-        const auto v = model_.watched_velocity();
-        met = has_converged(velocity_old_, v, options_.abs_tol, options_.rel_tol);
-        break;
-      }
-      case Criterion::natural_residual:
-        met = residual <= options_.abs_tol + options_.rel_tol * result_.norm_c;
-        break;
-    }
-    if (met && k >= options_.min_iterations) {
-      result_.converged = true;
-      return true;
-    }
-    return false;
-  }
-
-  /// ‖F(Λ)‖ of the current percussions.
-  double natural_residual() {
-    model_.velocities(lambda_, xi_);
-    return natural_map_residual(lambda_, xi_, mu_);
-  }
-
-  /// Fills residual and norm_max for the returned Λ. A non-finite Λ or residual is divergence,
-  /// never convergence.
-  void finish() {
-    result_.residual = natural_residual();
-    result_.norm_max = std::max({result_.norm_c, norm(lambda_), norm(xi_)});
-    if (!all_finite(lambda_) || !std::isfinite(result_.residual)) {
-      result_.diverged = true;
-      result_.converged = false;
-    }
-  }
-
-  const std::vector<double>& mu() const { return mu_; }
-
- private:
-  const Model& model_;
-  const SolverOptions& options_;
-  std::vector<Vector3>& lambda_;
-  SolverResult& result_;
-  std::vector<Vector3> lambda_old_;
-  std::vector<double> velocity_old_;
-  std::vector<Vector3> xi_;
-  std::vector<double> mu_;
+/// How the power iteration starts.
+enum class Start {
+  apgd,       ///< (1, 0.5, 0.25) for every contact: APGD's estimate, as it always was
+  scrambled,  ///< the same magnitudes with pseudo-random signs (spectral r-factors)
 };
 
-using Clock = std::chrono::steady_clock;
-
-/// APGD doubles L at most this many times in one iteration (a factor 2⁶⁰ ≈ 10¹⁸): enough for any
-/// underestimate of λ_max(G) by the power iteration, and a bound on the work of one iteration.
-constexpr int kMaxBacktracking = 60;
-
-double seconds_since(Clock::time_point start) {
-  return std::chrono::duration<double>(Clock::now() - start).count();
-}
-
-template <class Model>
-SolverResult run_sor(Model& model, std::vector<Vector3>& lambda, const SolverOptions& options) {
-  const auto start = Clock::now();
-  SolverResult result;
-  result.solver = "SOR";
-  const std::vector<RFactors> r = model_r_factors(model, options.r_strategy, options.alpha);
-  model.synchronize();
-  Monitor<Model> monitor(model, options, lambda, result);
-  // The test sits at the end of the body: with max_iterations = INT_MAX the loop must stop
-  // before ++k overflows.
-  for (int k = 1;; ++k) {
-    monitor.before();
-    model.sor_sweep(r, options.form);
-    if (monitor.after(k) || k == options.max_iterations) break;
-  }
-  monitor.finish();
-  result.seconds = seconds_since(start);
-  return result;
-}
-
-template <class Model>
-SolverResult run_jor(Model& model, std::vector<Vector3>& lambda, const SolverOptions& options) {
-  const auto start = Clock::now();
-  SolverResult result;
-  result.solver = "JOR";
-  const std::vector<RFactors> r = model_r_factors(model, options.r_strategy, options.alpha);
-  model.synchronize();
-  Monitor<Model> monitor(model, options, lambda, result);
-  std::vector<Vector3> xi;
-  for (int k = 1;; ++k) {  // stops at max_iterations at the end of the body, as run_sor
-    monitor.before();
-    model.velocities(lambda, xi);
-    for (std::size_t i = 0; i < lambda.size(); ++i) {
-      lambda[i] = prox_update(options.form, lambda[i], xi[i], r[i], model.mu(i));
-    }
-    model.record(xi, options.criterion == Criterion::velocity_change);
-    if (monitor.after(k) || k == options.max_iterations) break;
-  }
-  model.done();
-  monitor.finish();
-  result.seconds = seconds_since(start);
-  return result;
+/// A sign ±1 from a hash of (i, k) (SplitMix64's finaliser): deterministic, no allocation.
+double scrambled_sign(std::size_t i, int k) {
+  std::uint64_t z = 3 * static_cast<std::uint64_t>(i) + static_cast<std::uint64_t>(k) +
+                    0x9e3779b97f4a7c15ULL;
+  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
+  z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
+  z ^= z >> 31;
+  return (z & 1U) != 0U ? -1.0 : 1.0;
 }
 
 /// λ_max(G) by power iteration from a fixed start vector, with the linear part G of ξ(Λ) applied
 /// directly (Model::apply_G), not as ξ(x) − ξ(0): that difference loses G x in the rounding
 /// of ξ(0) = c when ‖G x‖ ≪ ‖c‖ (a problem with c ≈ 10²⁰⁰, or with G ≈ 10⁻³⁰⁰).
 template <class Model>
-double largest_eigenvalue(const Model& model, int iterations) {
+double largest_eigenvalue(Model& model, int iterations, Start start, Workspace& ws) {
   const std::size_t n = model.size();
-  std::vector<Vector3> x(n, Vector3(1.0, 0.5, 0.25)), y;
+  std::vector<Vector3>& x = ws.power_x;
+  std::vector<Vector3>& y = ws.power_y;
+  x.assign(n, Vector3(1.0, 0.5, 0.25));
+  if (start == Start::scrambled) {
+    for (std::size_t i = 0; i < n; ++i) {
+      for (int k = 0; k < 3; ++k) x[i](k) *= scrambled_sign(i, k);
+    }
+  }
   double estimate = 0.0;
   for (int k = 0; k < iterations; ++k) {
     const double scale = norm(x);
@@ -390,53 +371,213 @@ double largest_eigenvalue(const Model& model, int iterations) {
   return estimate;
 }
 
+/// The r-factors of `strategy` (not automatic) into ws.r.
 template <class Model>
-SolverResult run_apgd(Model& model, std::vector<Vector3>& lambda, const SolverOptions& options) {
-  const auto start = Clock::now();
-  SolverResult result;
-  result.solver = "APGD";
-  const std::size_t n = model.size();
-  model.synchronize();
-  Monitor<Model> monitor(model, options, lambda, result);
-  // Step t = α/L. L starts from a power-iteration estimate of λ_max(G) and is doubled whenever
-  // the step fails the sufficient-decrease test of the quadratic part,
-  // (x − y)ᵀ G (x − y) ≤ L ‖x − y‖² (backtracking, as in Mazhar et al. 2015); it shrinks by 10 %
-  // after each accepted step so that it follows the local curvature.
-  double L = largest_eigenvalue(model, 20);
-  if (!(L > 0.0)) L = 1.0;
+void compute_r_factors(Model& model, RFactorStrategy strategy, double alpha, Workspace& ws) {
+  std::vector<RFactors>& r = ws.r;
+  r.resize(model.size());
+  if (strategy == RFactorStrategy::per_contact) {
+    for (std::size_t i = 0; i < r.size(); ++i) r[i] = r_factors(model.delassus(i), alpha);
+    return;
+  }
+  double largest = 0.0;
+  if (strategy == RFactorStrategy::global) {
+    for (std::size_t i = 0; i < r.size(); ++i) {
+      largest = std::max(largest, model.delassus(i).diagonal().maxCoeff());
+    }
+  } else {  // spectral
+    largest = spectral::kSafety *
+              largest_eigenvalue(model, spectral::kPowerIterations, Start::scrambled, ws);
+    if (!(largest > 0.0) || !std::isfinite(largest)) {
+      // The start vector in the null space of G, or an overflow: trace(G) ≥ λ_max(G) for a
+      // positive semidefinite G is a safe (if pessimistic) bound.
+      largest = 0.0;
+      for (std::size_t i = 0; i < r.size(); ++i) largest += model.delassus(i).trace();
+    }
+  }
+  std::fill(r.begin(), r.end(), RFactors{alpha / largest, alpha / largest});
+}
 
-  std::vector<Vector3> x_prev = lambda, y = lambda, xi_x, xi_prev, xi_y;
-  model.velocities(x_prev, xi_prev);
-  xi_y = xi_prev;
-  double theta = 1.0;
-  // The De Saxcé offset s_i = μ_i ‖ξ_T,i‖, frozen for a cycle of at most kCycle iterations.
-  constexpr int kCycle = 25;
-  const auto offset = [&](std::size_t i, const Vector3& xi) {
-    return model.mu(i) * norm2d(xi(1), xi(2));
-  };
-  std::vector<double> s(n);
-  for (std::size_t i = 0; i < n; ++i) s[i] = offset(i, xi_prev[i]);
-  int last_update = 0;
-  // Restart at iteration k: drop the momentum and take the offsets of the current iterate x.
-  const auto restart = [&](int k) {
-    theta = 1.0;
-    for (std::size_t i = 0; i < n; ++i) s[i] = offset(i, xi_x[i]);
-    last_update = k;
-  };
-  bool frictional = false;
-  for (std::size_t i = 0; i < n; ++i) frictional = frictional || model.mu(i) > 0.0;
-  for (int k = 1;; ++k) {  // stops at max_iterations at the end of the body, as run_sor
-    monitor.before();
+/// What the stopping test found after an iteration.
+enum class Verdict { diverged, met, not_met };
+
+/// The stopping test and the bookkeeping shared by the three methods.
+template <class Model>
+class Monitor {
+ public:
+  Monitor(Model& model, const SolverOptions& options, Workspace& ws, SolverResult& result)
+      : model_(model), options_(options), ws_(ws), result_(result) {
+    model.free_velocities(ws_.xi);
+    result_.norm_c = norm(ws_.xi);
+    ws_.mu.resize(model.size());
+    for (std::size_t i = 0; i < ws_.mu.size(); ++i) ws_.mu[i] = model.mu(i);
+  }
+
+  /// Call before an iteration changes Λ.
+  void before() {
+    if (options_.criterion == Criterion::percussion_change) {
+      const std::span<const Vector3> lambda = model_.lambda();
+      ws_.lambda_old.assign(lambda.begin(), lambda.end());
+    }
+    if (options_.criterion == Criterion::velocity_change) {
+      const auto v = model_.watched_velocity();
+      ws_.velocity_old.assign(v.begin(), v.end());
+    }
+  }
+
+  /// Call after iteration k (1-based) with the model up to date: `met` when the criterion holds
+  /// from min_iterations on; `diverged` (and result.diverged) when an iterate is not finite,
+  /// which stops the solver at once, whatever max_iterations says.
+  Verdict after(int k) {
+    result_.iterations = k;
+    const std::span<const Vector3> lambda = model_.lambda();
+    if (!all_finite(lambda)) {
+      result_.diverged = true;
+      return Verdict::diverged;
+    }
+    double residual = -1.0;
+    if (options_.record_history || options_.criterion == Criterion::natural_residual) {
+      residual = natural_residual();
+      if (options_.record_history) result_.history.push_back(residual);
+    }
+    bool met = false;
+    switch (options_.criterion) {
+      case Criterion::percussion_change:
+        met = has_converged(flat(std::span<const Vector3>(ws_.lambda_old)), flat(lambda),
+                            options_.abs_tol, options_.rel_tol);
+        break;
+      case Criterion::velocity_change:
+        met = has_converged(ws_.velocity_old, model_.watched_velocity(), options_.abs_tol,
+                            options_.rel_tol);
+        break;
+      case Criterion::natural_residual:
+        met = residual <= options_.abs_tol + options_.rel_tol * result_.norm_c;
+        break;
+    }
+    return met && k >= options_.min_iterations ? Verdict::met : Verdict::not_met;
+  }
+
+  /// ‖F(Λ)‖ of the current percussions.
+  double natural_residual() {
+    model_.velocities(model_.lambda(), ws_.xi);
+    return residual_norm(model_.lambda(), ws_.xi, ws_.mu);
+  }
+
+  /// Fills residual and norm_max for the returned Λ. A non-finite Λ or residual is divergence,
+  /// never convergence.
+  void finish() {
+    result_.residual = natural_residual();
+    const std::span<const Vector3> lambda = model_.lambda();
+    result_.norm_max = std::max({result_.norm_c, norm(lambda), norm(ws_.xi)});
+    if (!all_finite(lambda) || !std::isfinite(result_.residual)) {
+      result_.diverged = true;
+      result_.converged = false;
+    }
+  }
+
+ private:
+  Model& model_;
+  const SolverOptions& options_;
+  Workspace& ws_;
+  SolverResult& result_;
+};
+
+/// SOR: one Gauss–Seidel sweep per iteration; u is always in step with Λ.
+template <class Model>
+class SorPolicy {
+ public:
+  SorPolicy(Model& model, const SolverOptions& options, const Workspace& ws)
+      : model_(model), form_(options.form), r_(ws.r) {}
+  void iterate(int /*k*/) { model_.sor_sweep(r_, form_); }
+  void synchronize_for_hook() {}
+  bool accept(int /*k*/) { return true; }
+  void finish() {}
+
+ private:
+  Model& model_;
+  ProxForm form_;
+  std::span<const RFactors> r_;
+};
+
+/// JOR: every contact updated from the velocities of the previous iterate.
+template <class Model>
+class JorPolicy {
+ public:
+  JorPolicy(Model& model, const SolverOptions& options, Workspace& ws)
+      : model_(model),
+        form_(options.form),
+        velocity_watched_(options.criterion == Criterion::velocity_change),
+        ws_(ws) {}
+  void iterate(int /*k*/) {
+    const std::span<Vector3> lambda = model_.lambda();
+    model_.velocities(lambda, ws_.jor_xi);
+    for (std::size_t i = 0; i < lambda.size(); ++i) {
+      lambda[i] = prox_update(form_, lambda[i], ws_.jor_xi[i], ws_.r[i], model_.mu(i));
+    }
+    model_.record(ws_.jor_xi, velocity_watched_);
+  }
+  /// record() has synchronised u already when the velocity criterion watches it.
+  void synchronize_for_hook() {
+    if (!velocity_watched_) model_.update_u();
+  }
+  bool accept(int /*k*/) { return true; }
+  void finish() { model_.done(); }
+
+ private:
+  Model& model_;
+  ProxForm form_;
+  bool velocity_watched_;
+  Workspace& ws_;
+};
+
+/// APGD: a Nesterov step with backtracking on L and adaptive restart; the De Saxcé offset s is
+/// frozen for a cycle, and a met criterion counts only when s is consistent with the iterate.
+template <class Model>
+class ApgdPolicy {
+ public:
+  ApgdPolicy(Model& model, const SolverOptions& options, Workspace& ws)
+      : model_(model),
+        options_(options),
+        velocity_watched_(options.criterion == Criterion::velocity_change),
+        ws_(ws) {
+    const std::size_t n = model.size();
+    // Step t = α/L. L starts from a power-iteration estimate of λ_max(G) and is doubled whenever
+    // the step fails the sufficient-decrease test of the quadratic part,
+    // (x − y)ᵀ G (x − y) ≤ L ‖x − y‖² (backtracking, as in Mazhar et al. 2015); it shrinks by
+    // 10 % after each accepted step so that it follows the local curvature.
+    L_ = largest_eigenvalue(model, apgd::kPowerIterations, Start::apgd, ws);
+    if (!(L_ > 0.0)) L_ = apgd::kFallbackLipschitz;
+    const std::span<const Vector3> lambda = model.lambda();
+    ws.x_prev.assign(lambda.begin(), lambda.end());
+    ws.y.assign(lambda.begin(), lambda.end());
+    model.velocities(ws.x_prev, ws.xi_prev);
+    ws.xi_y.assign(ws.xi_prev.begin(), ws.xi_prev.end());
+    // The De Saxcé offset s_i = μ_i ‖ξ_T,i‖, frozen for a cycle of at most kOffsetCycle
+    // iterations.
+    ws.s.resize(n);
+    for (std::size_t i = 0; i < n; ++i) ws.s[i] = offset(i, ws.xi_prev[i]);
+    for (std::size_t i = 0; i < n; ++i) frictional_ = frictional_ || model.mu(i) > 0.0;
+  }
+
+  void iterate(int k) {
+    const std::size_t n = model_.size();
+    const std::span<Vector3> lambda = model_.lambda();
+    std::vector<Vector3>& y = ws_.y;
+    std::vector<Vector3>& x_prev = ws_.x_prev;
+    std::vector<Vector3>& xi_x = ws_.xi_x;
+    std::vector<Vector3>& xi_y = ws_.xi_y;
+    std::vector<Vector3>& xi_prev = ws_.xi_prev;
+    const std::vector<double>& s = ws_.s;
     for (int attempt = 0;; ++attempt) {
       // x = P_K(y − t (ξ(y) + μ ‖ξ_T(y)‖ e_N)): one De Saxcé prox step from the extrapolated
       // point.
-      const double t = options.alpha / L;
+      const double t = options_.alpha / L_;
       for (std::size_t i = 0; i < n; ++i) {
         Vector3 g = xi_y[i];
         g(0) += s[i];
-        lambda[i] = prox_cone(y[i] - t * g, model.mu(i));
+        lambda[i] = prox_cone(y[i] - t * g, model_.mu(i));
       }
-      model.velocities(lambda, xi_x);
+      model_.velocities(lambda, xi_x);
       // G (x − y) = ξ(x) − ξ(y): ξ is affine in Λ. Both sides of the test are divided by
       // d² = max |x − y|², so that neither overflows nor underflows for percussions of 10²⁰⁰
       // or 10⁻²⁰⁰ (a NaN from ∞ − ∞ would fail the test and drive L up for good).
@@ -452,8 +593,11 @@ SolverResult run_apgd(Model& model, std::vector<Vector3>& lambda, const SolverOp
         curvature += dx.dot((xi_x[i] - xi_y[i]) / d);
         step2 += dx.squaredNorm();
       }
-      if (curvature <= L * step2 * (1.0 + 1e-12) || attempt == kMaxBacktracking) break;
-      L *= 2.0;
+      if (curvature <= L_ * step2 * (1.0 + apgd::kDecreaseSlack) ||
+          attempt == apgd::kMaxBacktracking) {
+        break;
+      }
+      L_ *= 2.0;
     }
     // Adaptive restart (O'Donoghue and Candès 2015): drop the momentum when the step goes against
     // the direction of descent, g(y)ᵀ(x − x_prev) > 0.
@@ -475,84 +619,216 @@ SolverResult run_apgd(Model& model, std::vector<Vector3>& lambda, const SolverOp
       }
     }
     double beta = 0.0;
-    if (against > 0.0 || (frictional && k - last_update >= kCycle)) {
+    if (against > 0.0 || (frictional_ && k - last_update_ >= apgd::kOffsetCycle)) {
       // Restart, and take the cone offset s = μ ‖ξ_T‖ of the current iterate: each cycle solves
       // the convex problem with a fixed s (Anitescu's relaxation shifted by s), whose fixed point
       // over the cycles is Coulomb's law.
       restart(k);
     } else {
-      const double theta_next = 0.5 * (-theta * theta + theta * std::sqrt(theta * theta + 4.0));
-      beta = theta * (1.0 - theta) / (theta * theta + theta_next);
-      theta = theta_next;
+      const double theta_next =
+          0.5 * (-theta_ * theta_ + theta_ * std::sqrt(theta_ * theta_ + 4.0));
+      beta = theta_ * (1.0 - theta_) / (theta_ * theta_ + theta_next);
+      theta_ = theta_next;
     }
     // ξ is affine in Λ, so ξ(y) follows from ξ(x) and ξ(x_prev) without another product.
     for (std::size_t i = 0; i < n; ++i) {
       y[i] = lambda[i] + beta * (lambda[i] - x_prev[i]);
       xi_y[i] = xi_x[i] + beta * (xi_x[i] - xi_prev[i]);
     }
-    x_prev = lambda;
-    xi_prev = xi_x;
-    L *= 0.9;
-    model.record(xi_x, options.criterion == Criterion::velocity_change);
-    if (monitor.after(k)) {
-      if (result.diverged || !frictional || options.criterion == Criterion::natural_residual) break;
-      // Percussions or velocities that stopped changing within a cycle are the solution of this
-      // cycle's convex problem, with the offset s frozen; they solve Coulomb's law only if s is
-      // also the offset μ ‖ξ_T‖ of the iterate itself. Otherwise refresh s, restart and go on.
-      bool consistent = true;
-      for (std::size_t i = 0; i < n && consistent; ++i) {
-        const double s_now = offset(i, xi_x[i]);
-        consistent = std::abs(s_now - s[i]) <= options.abs_tol + options.rel_tol * s_now;
-      }
-      if (consistent) break;
-      result.converged = false;
-      restart(k);
-      y = lambda;
-      xi_y = xi_x;
+    x_prev.assign(lambda.begin(), lambda.end());
+    xi_prev.assign(xi_x.begin(), xi_x.end());
+    L_ *= apgd::kShrink;
+    model_.record(xi_x, velocity_watched_);
+  }
+
+  /// record() has synchronised u already when the velocity criterion watches it.
+  void synchronize_for_hook() {
+    if (!velocity_watched_) model_.update_u();
+  }
+
+  /// The criterion is met at iteration k. Percussions or velocities that stopped changing within
+  /// a cycle are the solution of this cycle's convex problem, with the offset s frozen; they solve
+  /// Coulomb's law only if s is also the offset μ ‖ξ_T‖ of the iterate itself. Otherwise refresh
+  /// s, restart from the iterate and go on. (The natural residual measures Coulomb's law itself.)
+  bool accept(int k) {
+    if (!frictional_ || options_.criterion == Criterion::natural_residual) return true;
+    const std::size_t n = model_.size();
+    bool consistent = true;
+    for (std::size_t i = 0; i < n && consistent; ++i) {
+      const double s_now = offset(i, ws_.xi_x[i]);
+      consistent = std::abs(s_now - ws_.s[i]) <= options_.abs_tol + options_.rel_tol * s_now;
+    }
+    if (consistent) return true;
+    restart(k);
+    const std::span<const Vector3> lambda = model_.lambda();
+    ws_.y.assign(lambda.begin(), lambda.end());
+    ws_.xi_y.assign(ws_.xi_x.begin(), ws_.xi_x.end());
+    return false;
+  }
+
+  void finish() { model_.done(); }
+
+ private:
+  double offset(std::size_t i, const Vector3& xi) const {
+    return model_.mu(i) * norm2d(xi(1), xi(2));
+  }
+  /// Restart at iteration k: drop the momentum and take the offsets of the current iterate x.
+  void restart(int k) {
+    theta_ = 1.0;
+    for (std::size_t i = 0; i < model_.size(); ++i) ws_.s[i] = offset(i, ws_.xi_x[i]);
+    last_update_ = k;
+  }
+
+  Model& model_;
+  const SolverOptions& options_;
+  bool velocity_watched_;
+  Workspace& ws_;
+  double L_ = 0.0;
+  double theta_ = 1.0;
+  int last_update_ = 0;
+  bool frictional_ = false;
+};
+
+/// The one loop of every method: before → iteration → hook → stopping test (local, then global;
+/// APGD's acceptance in between) → stop at max_iterations.
+template <class Model, class Policy>
+void iterate(Model& model, Policy& policy, Monitor<Model>& monitor, const SolverOptions& options,
+             const SolverHooks& hooks, SolverResult& result) {
+  // The test sits at the end of the body: with max_iterations = INT_MAX the loop must stop
+  // before ++k overflows.
+  for (int k = 1;; ++k) {
+    monitor.before();
+    policy.iterate(k);
+    if (hooks.after_iteration) {
+      policy.synchronize_for_hook();
+      hooks.after_iteration(k, model.lambda(), model.u());
+    }
+    const Verdict verdict = monitor.after(k);
+    if (verdict == Verdict::diverged) break;
+    const bool local = verdict == Verdict::met && policy.accept(k);
+    const bool global = hooks.global_converged ? hooks.global_converged(local) : local;
+    if (global) {
+      result.converged = true;
+      break;
     }
     if (k == options.max_iterations) break;
   }
-  model.done();
+  policy.finish();
+}
+
+using Clock = std::chrono::steady_clock;
+
+double seconds_since(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+/// Runs `method` on a model whose Λ holds the initial guess.
+template <class Model>
+SolverResult run(Method method, Model& model, const SolverOptions& options,
+                 const SolverHooks& hooks, Workspace& ws) {
+  const auto start = Clock::now();
+  SolverResult result;
+  result.solver = method_name(method);  // at most 4 characters: no allocation
+  if (method != Method::apgd) {
+    compute_r_factors(model, resolve(options.r_strategy, method), options.alpha, ws);
+  }
+  model.synchronize();
+  Monitor<Model> monitor(model, options, ws, result);
+  switch (method) {
+    case Method::sor: {
+      SorPolicy<Model> policy(model, options, ws);
+      iterate(model, policy, monitor, options, hooks, result);
+      break;
+    }
+    case Method::jor: {
+      JorPolicy<Model> policy(model, options, ws);
+      iterate(model, policy, monitor, options, hooks, result);
+      break;
+    }
+    case Method::apgd: {
+      ApgdPolicy<Model> policy(model, options, ws);
+      iterate(model, policy, monitor, options, hooks, result);
+      break;
+    }
+  }
   monitor.finish();
   result.seconds = seconds_since(start);
   return result;
 }
 
-SolverResult solve_body(const ContactProblem& problem, ContactSolution& solution,
-                        const SolverOptions& options, const char* name,
-                        SolverResult (*method)(BodyModel&, std::vector<Vector3>&,
-                                               const SolverOptions&)) {
-  validate_options(options, name);
-  validate(problem);
-  prepare_guess(solution.lambda, problem.contacts.size(), name);
-  BodyModel model(problem, solution.lambda);
-  SolverResult result = method(model, solution.lambda, options);
-  solution.u = std::move(model.u);
-  return result;
+/// The body form after the problem is validated and G computed.
+SolverResult solve_body(Method method, const ContactProblem& problem, std::span<const Matrix3> G,
+                        ContactSolution& solution, const SolverOptions& options,
+                        const SolverHooks& hooks, Workspace& ws, const char* where) {
+  prepare_guess(solution.lambda, problem.contacts.size(), where);
+  BodyModel model(problem, G, solution.lambda, solution.u, ws);
+  return run(method, model, options, hooks, ws);
 }
 
-SolverResult solve_local(const LocalProblem& problem, std::vector<Vector3>& lambda,
-                         const SolverOptions& options, const char* name,
-                         SolverResult (*method)(LocalModel&, std::vector<Vector3>&,
-                                                const SolverOptions&)) {
-  validate_options(options, name);
+/// Validates the problem and computes its Delassus blocks into ws.G.
+void prepare_problem(const ContactProblem& problem, Workspace& ws) {
   validate(problem);
-  prepare_guess(lambda, problem.q.size(), name);
-  LocalModel model(problem, lambda);
-  return method(model, lambda, options);
+  ws.G.resize(problem.contacts.size());
+  for (std::size_t i = 0; i < ws.G.size(); ++i) {
+    ws.G[i] = delassus_block(problem.contacts[i], problem.M_inv);
+  }
+}
+
+SolverResult solve_body_once(Method method, const ContactProblem& problem,
+                             ContactSolution& solution, const SolverOptions& options,
+                             const char* where) {
+  validate_options(options, where);
+  Workspace ws;
+  prepare_problem(problem, ws);
+  return solve_body(method, problem, ws.G, solution, options, {}, ws, where);
+}
+
+SolverResult solve_local(Method method, const LocalProblem& problem, std::vector<Vector3>& lambda,
+                         const SolverOptions& options, const SolverHooks& hooks, Workspace& ws,
+                         const char* where) {
+  validate(problem);
+  prepare_guess(lambda, problem.q.size(), where);
+  LocalModel model(problem, lambda, ws);
+  return run(method, model, options, hooks, ws);
+}
+
+SolverResult solve_local_once(Method method, const LocalProblem& problem,
+                              std::vector<Vector3>& lambda, const SolverOptions& options,
+                              const char* where) {
+  validate_options(options, where);
+  Workspace ws;
+  return solve_local(method, problem, lambda, options, {}, ws, where);
 }
 
 }  // namespace
+
+std::string_view method_name(Method method) {
+  switch (method) {
+    case Method::sor:
+      return "SOR";
+    case Method::jor:
+      return "JOR";
+    case Method::apgd:
+      return "APGD";
+  }
+  validate_method(method, "method_name");
+  return {};
+}
 
 std::vector<RFactors> r_factors(const ContactProblem& problem, RFactorStrategy strategy,
                                 double alpha) {
   // The solvers check these once before they compute r-factors; here the caller gets the same.
   SolverOptions options;
   options.alpha = alpha;
+  options.r_strategy = strategy;
   validate_options(options, "r_factors");
-  validate(problem);
+  Workspace ws;
+  prepare_problem(problem, ws);
   std::vector<Vector3> none;
-  return model_r_factors(BodyModel(problem, none), strategy, alpha);
+  std::vector<Vector6> u;
+  BodyModel model(problem, ws.G, none, u, ws);
+  compute_r_factors(model, resolve(strategy, Method::sor), alpha, ws);
+  return std::move(ws.r);
 }
 
 std::string describe(const SolverResult& result) {
@@ -569,29 +845,76 @@ std::string describe(const SolverResult& result) {
   return line;
 }
 
+// ---------------------------------------------------------------------------------------------
+// ContactSolver
+// ---------------------------------------------------------------------------------------------
+
+ContactSolver::ContactSolver(Method method, SolverOptions options, SolverHooks hooks)
+    : method_(method),
+      options_(options),
+      hooks_(std::move(hooks)),
+      workspace_(std::make_unique<Workspace>()) {
+  validate_method(method_, "ContactSolver");
+  validate_options(options_, "ContactSolver");
+}
+
+ContactSolver::~ContactSolver() = default;
+ContactSolver::ContactSolver(ContactSolver&&) noexcept = default;
+ContactSolver& ContactSolver::operator=(ContactSolver&&) noexcept = default;
+
+SolverResult ContactSolver::solve(const ContactProblem& problem, ContactSolution& solution) {
+  prepare_problem(problem, *workspace_);
+  return solve_body(method_, problem, workspace_->G, solution, options_, hooks_, *workspace_,
+                    "ContactSolver::solve");
+}
+
+SolverResult ContactSolver::solve_prepared(const ContactProblem& problem,
+                                           std::span<const Matrix3> G,
+                                           ContactSolution& solution) {
+  if (G.size() != problem.contacts.size() || problem.u_free.size() != problem.M_inv.size()) {
+    throw InvalidArgument("ContactSolver::solve_prepared: expected one Delassus block per contact "
+                          "and one u_free per body; found " + std::to_string(G.size()) +
+                          " blocks for " + std::to_string(problem.contacts.size()) +
+                          " contacts and " + std::to_string(problem.u_free.size()) +
+                          " free velocities for " + std::to_string(problem.M_inv.size()) +
+                          " bodies");
+  }
+  return solve_body(method_, problem, G, solution, options_, hooks_, *workspace_,
+                    "ContactSolver::solve_prepared");
+}
+
+SolverResult ContactSolver::solve(const LocalProblem& problem, std::vector<Vector3>& lambda) {
+  return solve_local(method_, problem, lambda, options_, hooks_, *workspace_,
+                     "ContactSolver::solve");
+}
+
+// ---------------------------------------------------------------------------------------------
+// The free functions: one-shot solvers
+// ---------------------------------------------------------------------------------------------
+
 SolverResult solve_sor(const ContactProblem& problem, ContactSolution& solution,
                        const SolverOptions& options) {
-  return solve_body(problem, solution, options, "solve_sor", run_sor<BodyModel>);
+  return solve_body_once(Method::sor, problem, solution, options, "solve_sor");
 }
 SolverResult solve_jor(const ContactProblem& problem, ContactSolution& solution,
                        const SolverOptions& options) {
-  return solve_body(problem, solution, options, "solve_jor", run_jor<BodyModel>);
+  return solve_body_once(Method::jor, problem, solution, options, "solve_jor");
 }
 SolverResult solve_apgd(const ContactProblem& problem, ContactSolution& solution,
                         const SolverOptions& options) {
-  return solve_body(problem, solution, options, "solve_apgd", run_apgd<BodyModel>);
+  return solve_body_once(Method::apgd, problem, solution, options, "solve_apgd");
 }
 SolverResult solve_sor(const LocalProblem& problem, std::vector<Vector3>& lambda,
                        const SolverOptions& options) {
-  return solve_local(problem, lambda, options, "solve_sor", run_sor<LocalModel>);
+  return solve_local_once(Method::sor, problem, lambda, options, "solve_sor");
 }
 SolverResult solve_jor(const LocalProblem& problem, std::vector<Vector3>& lambda,
                        const SolverOptions& options) {
-  return solve_local(problem, lambda, options, "solve_jor", run_jor<LocalModel>);
+  return solve_local_once(Method::jor, problem, lambda, options, "solve_jor");
 }
 SolverResult solve_apgd(const LocalProblem& problem, std::vector<Vector3>& lambda,
                         const SolverOptions& options) {
-  return solve_local(problem, lambda, options, "solve_apgd", run_apgd<LocalModel>);
+  return solve_local_once(Method::apgd, problem, lambda, options, "solve_apgd");
 }
 
 }  // namespace grbd::contact

@@ -68,6 +68,9 @@ class CellGrid {
   };
   std::vector<Ball> balls_;
   std::vector<std::int32_t> index_;  // input index of each ball
+  // Scratch of find_pairs(): the balls of one cell's neighbourhood, kept between calls.
+  mutable std::vector<Ball> near_;
+  mutable std::vector<std::int32_t> near_index_;
 };
 
 /// Every pair i < j with |c_i − c_j| < r_i + r_j + margin by testing all N(N − 1)/2 pairs: the

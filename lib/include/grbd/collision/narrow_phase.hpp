@@ -78,4 +78,13 @@ void capsule_half_space(const Capsule& capsule, const Placement& capsule_placeme
                         const HalfSpace& half_space, double margin,
                         std::vector<ContactGeometry>& out);
 
+/// The narrow phase of any supported pair (supported()), shapes a and b placed by `pa` and `pb`,
+/// with kind(a) ≤ kind(b) in the order sphere, box, capsule, half-space, mesh (so that the sphere
+/// comes first and the half-space or mesh last, as the kernels take them). Appends every contact
+/// geometry the kernel returns, whatever its gap, except that multi-contact kernels (box and
+/// capsule on a half-space, sphere on a mesh) leave out those beyond `margin`; the caller keeps
+/// those with g_N ≤ margin. Throws InvalidArgument for an unsupported pair or the wrong order.
+void collide(const Shape& a, const Placement& pa, const Shape& b, const Placement& pb,
+             double margin, std::vector<ContactGeometry>& out);
+
 }  // namespace grbd::collision

@@ -49,6 +49,16 @@ ShapeKind kind(const Shape& shape);
 /// "sphere", "box", "capsule", "half-space" or "mesh".
 std::string_view kind_name(ShapeKind kind);
 
+/// The radius of the sphere about the shape's origin that holds a sphere, box or capsule; 0 for
+/// the static-only shapes (half-space, mesh).
+double bounding_radius(const Shape& shape);
+
+/// Throws InvalidArgument, starting with `where`, unless the shape is valid: a finite radius and
+/// half extents > 0, a finite capsule half length ≥ 0, a finite non-zero half-space normal with a
+/// finite offset, a mesh that is not null. A half-space is rescaled to a unit normal (the same
+/// plane).
+void normalize_and_check(Shape& shape, std::string_view where);
+
 /// Index of a body in the system's body arrays; kStatic for shapes fixed in frame I.
 using BodyIndex = std::int32_t;
 /// The body index of static shapes (half-spaces, meshes, static boxes).

@@ -3,6 +3,7 @@
 /// \brief The collision world: the colliders of a scene, checked for supported pairs when the
 /// scene is assembled, and contact detection for given body states (chapter 4).
 
+#include <array>
 #include <cstddef>
 #include <span>
 #include <string>
@@ -11,6 +12,7 @@
 #include "grbd/body/rigid_body.hpp"
 #include "grbd/collision/broad_phase.hpp"
 #include "grbd/collision/contact.hpp"
+#include "grbd/collision/narrow_phase.hpp"
 #include "grbd/collision/shapes.hpp"
 
 namespace grbd::collision {
@@ -30,7 +32,13 @@ class CollisionWorld {
   /// non-positive size, a zero normal, a half-space or mesh attached to a body) and, naming both
   /// colliders, their kinds and the supported pairs, for a kind that cannot meet an existing
   /// collider: an unsupported pair is refused when the scene is assembled, never skipped later.
+  /// O(1): the pair check looks at one representative collider per shape kind, the first one
+  /// that could meet the new collider, so 10⁶ spheres are added in O(N).
   std::int32_t add(Collider collider);
+  /// Removes every collider (the buffers keep their capacity).
+  void clear();
+  /// Reserves room for `colliders` colliders.
+  void reserve(std::size_t colliders);
   /// The colliders, in the order they were added.
   std::span<const Collider> colliders() const { return colliders_; }
   /// All contacts with g_N ≤ margin for the body states `states` (indexed by BodyIndex), each with
@@ -38,7 +46,19 @@ class CollisionWorld {
   void detect(std::span<const body::State> states, double margin, std::vector<Contact>& contacts);
 
  private:
+  static constexpr int kShapeKinds = 5;  // the enumerators of ShapeKind
+  /// For one shape kind: the first static collider, the first moving one, and the first moving
+  /// one on a body other than that one's (-1: none), all add() needs to find a conflict.
+  struct Representatives {
+    std::int32_t first_static = -1;
+    std::int32_t first_moving = -1;
+    std::int32_t first_moving_other_body = -1;
+  };
   std::vector<Collider> colliders_;
+  std::array<Representatives, kShapeKinds> representatives_{};
+  std::vector<Placement> placements_;
+  std::vector<Matrix3> A_IK_;
+  std::vector<ContactGeometry> found_;
   CellGrid grid_;
   std::vector<Vector3> centres_;
   std::vector<double> radii_;

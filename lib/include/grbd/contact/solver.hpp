@@ -4,9 +4,19 @@
 /// Gauss–Seidel (SOR) prox iterations with r-factor strategies and convergence criteria, and an
 /// accelerated projected gradient method with adaptive restart (APGD), for the body form
 /// (ContactProblem) and the local form (LocalProblem) of the problem.
+///
+/// The three methods share one driver: every iteration is "remember what the stopping test
+/// compares; one iteration of the method; the hook SolverHooks::after_iteration; the stopping
+/// test, turned into a global verdict by SolverHooks::global_converged; stop at max_iterations".
+/// ContactSolver keeps the buffers of that loop between solves (a time stepper calls it once per
+/// step without allocating); the free functions solve_sor(), solve_jor() and solve_apgd() are
+/// one-shot wrappers around it.
 
+#include <functional>
+#include <memory>
 #include <span>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "grbd/contact/local_problem.hpp"
@@ -37,11 +47,77 @@ bool has_converged(std::span<const double> x_old, std::span<const double> x, dou
                    double rel_tol);
 // [converged declaration]
 
+/// The three iterative methods.
+enum class Method {
+  sor,   ///< projected Gauss–Seidel (successive over-relaxation)
+  jor,   ///< projected Jacobi (Jacobi over-relaxation)
+  apgd,  ///< accelerated projected gradient descent with adaptive restart
+};
+
+/// "SOR", "JOR" or "APGD" (SolverResult::solver); throws InvalidArgument for a value outside the
+/// enumerators.
+std::string_view method_name(Method method);
+
 /// How a solver picks the r-factors.
+///
+/// Why JOR and SOR need different ones: SOR updates one contact at a time, and each update sees
+/// the velocities its predecessors left, so for one contact it is the prox step of a 3 × 3
+/// problem, a contraction in the normal direction for r_N G_NN = α < 2 (r_factors()): per-contact
+/// r-factors are safe. JOR moves all contacts at once, from the same old velocities: for the
+/// frictionless problem it is the projected gradient step λ ← P(λ − r (G λ + c)), a contraction
+/// only for r < 2/λ_max(G). A sphere with twelve contacts receives twelve pushes at once, so
+/// λ_max(G) is several times max diag G and per-contact r-factors overshoot: JOR with α = 1 and
+/// per_contact diverges to ∞ on a sphere pile and on FCLIB problems (the solver then stops at once
+/// and reports SolverResult::diverged). Hence the default `automatic`.
 enum class RFactorStrategy {
   per_contact,  ///< r_i from r_factors(G_ii, α) for each contact
   global,       ///< one r = α / max_i max_k (G_ii)_kk for every contact and direction
+  /// one r = α / λ̂ for every contact and direction, with λ̂ = spectral::kSafety times the
+  /// power-iteration estimate of λ_max(G) (spectral::kPowerIterations iterations): with α < 2 JOR is
+  /// a contraction on frictionless problems unless the estimate is more than a factor
+  /// 2 kSafety / α below λ_max(G). Costs kPowerIterations products with G per solve.
+  spectral,
+  /// the default: per_contact for SOR, spectral for JOR (APGD takes no r-factors)
+  automatic,
 };
+
+/// The spectral r-factor strategy (RFactorStrategy::spectral).
+namespace spectral {
+/// Power iterations for λ_max(G), from a start vector with pseudo-random signs (so that no
+/// symmetry of a regular packing makes it orthogonal to the top eigenvector). The estimate
+/// ‖G x_k‖ approaches λ_max(G) from below; 50 iterations bring it within the factor kSafety of
+/// λ_max on the test problems (random problems, sphere pyramids), for the price of about 50 JOR
+/// iterations per solve.
+inline constexpr int kPowerIterations = 50;
+/// λ̂ = kSafety × estimate: covers the part of λ_max the power iteration has not yet found. Not a
+/// proven bound (the power iteration gives none); with α = 1, JOR stays a contraction on
+/// frictionless problems as long as the estimate is above λ_max/2.2.
+inline constexpr double kSafety = 1.1;
+}  // namespace spectral
+
+/// The constants of APGD (solve_apgd()), each with the reason for its value.
+namespace apgd {
+/// L is doubled at most this many times in one iteration (a factor 2⁶⁰ ≈ 10¹⁸): enough for any
+/// underestimate of λ_max(G) by the power iteration, and a bound on the work of one iteration.
+inline constexpr int kMaxBacktracking = 60;
+/// The De Saxcé cone offset s = μ ‖ξ_T‖ is frozen for at most this many iterations before it is
+/// refreshed with a restart: long enough for the accelerated method to make progress on each
+/// cycle's convex problem, short enough that a wrong s does not hold it back for long.
+inline constexpr int kOffsetCycle = 25;
+/// Power iterations for the starting L ≈ λ_max(G): a rough estimate suffices, because
+/// backtracking corrects an underestimate and the kShrink decay an overestimate.
+inline constexpr int kPowerIterations = 20;
+/// L when the power iteration gives 0 (or not a positive number): any positive value works,
+/// backtracking doubles it up to the curvature of the problem.
+inline constexpr double kFallbackLipschitz = 1.0;
+/// L shrinks by this factor after each accepted step, so that it follows the local curvature
+/// down after backtracking raised it; at 0.9 it costs at most one extra doubling every
+/// ln 2 / ln(1/0.9) ≈ 7 iterations when L is right.
+inline constexpr double kShrink = 0.9;
+/// Relative slack of the sufficient-decrease test (x − y)ᵀG(x − y) ≤ L ‖x − y‖² (1 + kDecreaseSlack):
+/// rounding in the two sides must not count as a failed step and double L.
+inline constexpr double kDecreaseSlack = 1e-12;
+}  // namespace apgd
 
 /// What a solver watches to stop.
 enum class Criterion {
@@ -50,17 +126,18 @@ enum class Criterion {
   natural_residual,   ///< ‖F‖ ≤ abs_tol + rel_tol ‖c‖ with F the natural map, c = free ξ
 };
 
-/// Options of every solver. Defaults suit a time step of a granular simulation. The solvers
-/// refuse (InvalidArgument) iteration counts outside 0 ≤ min_iterations ≤ max_iterations,
-/// max_iterations ≥ 1 (INT_MAX is allowed), tolerances that are negative or not finite, α ∉ (0, 2)
-/// and enum values outside their enumerators.
+/// Options of every solver. Defaults suit a time step of a granular simulation and converge with
+/// every method (JOR through RFactorStrategy::automatic). The solvers refuse (InvalidArgument)
+/// iteration counts outside 0 ≤ min_iterations ≤ max_iterations, max_iterations ≥ 1 (INT_MAX is
+/// allowed), tolerances that are negative or not finite, α ∉ (0, 2) and enum values outside their
+/// enumerators.
 struct SolverOptions {
   int min_iterations = 1;           ///< iterations always done
   int max_iterations = 1000;        ///< iterations at most; stopping there is non-convergence
   double abs_tol = 1e-12;           ///< absolute tolerance of the criterion
   double rel_tol = 1e-6;            ///< relative tolerance of the criterion
   Criterion criterion = Criterion::percussion_change;  ///< stopping test
-  RFactorStrategy r_strategy = RFactorStrategy::per_contact;  ///< r-factors of JOR and SOR
+  RFactorStrategy r_strategy = RFactorStrategy::automatic;  ///< r-factors of JOR and SOR
   double alpha = 1.0;               ///< relaxation α ∈ (0, 2) of the r-factors
   ProxForm form = ProxForm::alart_curnier;  ///< prox update of JOR and SOR
   bool record_history = false;      ///< store the natural-map residual after every iteration
@@ -69,7 +146,7 @@ struct SolverOptions {
 /// What a solver did. Non-convergence is not an exception: `converged` is false and the numbers
 /// say how far it got (describe() words it).
 struct SolverResult {
-  std::string solver;            ///< "SOR", "JOR" or "APGD"
+  std::string solver;            ///< method_name(): "SOR", "JOR" or "APGD"
   bool converged = false;        ///< the criterion was met within max_iterations
   /// an iterate or the residual was not finite (∞ or NaN): the solver stopped at once; never
   /// together with `converged`
@@ -97,8 +174,9 @@ struct ContactSolution {
   std::vector<Vector6> u;       ///< end velocity per body
 };
 
-/// The r-factors of every contact of `problem` for `strategy` and relaxation α. Throws
-/// InvalidArgument for a problem that validate() refuses or α outside (0, 2).
+/// The r-factors of every contact of `problem` for `strategy` and relaxation α (`automatic` gives
+/// SOR's choice, per_contact). Throws InvalidArgument for a problem that validate() refuses or α
+/// outside (0, 2).
 std::vector<RFactors> r_factors(const ContactProblem& problem, RFactorStrategy strategy,
                                 double alpha);
 
@@ -112,8 +190,72 @@ void sor_sweep(const ContactProblem& problem, std::span<const RFactors> r, ProxF
                std::span<Vector6> u, std::span<Vector3> lambda);
 // [sor sweep declaration]
 
+/// Where a distributed solver (chapter 8) plugs into the iteration of every method: split-body
+/// averaging after each sweep, and a global convergence verdict. Empty members are not called.
+struct SolverHooks {
+  /// Called after every iteration k = 1, 2, …, iterations (1-based), before the stopping test,
+  /// with Λ and, in the body form, the body velocities u (empty in the local form). SOR keeps u in
+  /// step with Λ anyway; JOR and APGD, which change all of Λ at once, bring u up to date first
+  /// only when this hook is set. Changes to u are seen by the next SOR sweep and by the stopping
+  /// test; JOR and APGD recompute u from Λ (and do so once more at the end), so for them only
+  /// changes to Λ count, and APGD's own buffers (momentum, ξ) do not follow such a change.
+  std::function<void(int k, std::span<Vector3> lambda, std::span<Vector6> u)> after_iteration;
+  /// Turns this process's verdict of the stopping test (criterion met and k ≥ min_iterations; for
+  /// APGD also its cone offset consistent) into the global one: with MPI a logical AND over the
+  /// ranks. Called once in every iteration, so that a collective reduction stays matched across
+  /// processes, except in the iteration where an iterate turns out not finite: that process stops
+  /// at once (diverged) without calling it. `converged` is the value it returns.
+  std::function<bool(bool locally_converged)> global_converged;
+};
+
+namespace detail {
+struct SolverWorkspace;  ///< the buffers of ContactSolver (solver.cpp)
+}  // namespace detail
+
+/// A reusable solver: one method, its options and hooks, and a workspace that keeps its
+/// capacity. After the first solve, a solve of a problem of the same or smaller size (contacts
+/// and bodies) allocates nothing on the heap, unless options().record_history asks for the
+/// history, or the caller's ContactSolution must grow. Movable, not copyable.
+class ContactSolver {
+ public:
+  /// Validates the options once (InvalidArgument, as the free functions do).
+  explicit ContactSolver(Method method = Method::sor, SolverOptions options = {},
+                         SolverHooks hooks = {});
+  ~ContactSolver();                                     ///< frees the workspace
+  ContactSolver(ContactSolver&&) noexcept;              ///< takes over the workspace
+  ContactSolver& operator=(ContactSolver&&) noexcept;   ///< takes over the workspace
+  ContactSolver(const ContactSolver&) = delete;
+  ContactSolver& operator=(const ContactSolver&) = delete;
+
+  /// Validates the problem (contact::validate(), InvalidArgument) and the initial guess
+  /// (`solution.lambda`: empty means zero), computes the Delassus blocks G_ii and the r-factors
+  /// once, and solves; `solution.u` receives the end velocities.
+  SolverResult solve(const ContactProblem& problem, ContactSolution& solution);
+  /// The same for a problem the caller has already validated (contact::validate()) and whose
+  /// diagonal Delassus blocks it has computed, G[i] = delassus_block(contacts[i], M_inv): the
+  /// problem is neither validated nor G recomputed; only the sizes are checked (O(1)) and the
+  /// initial guess (O(n)). What a time stepper calls once per step. Gives bit-identical results
+  /// to solve().
+  SolverResult solve_prepared(const ContactProblem& problem, std::span<const Matrix3> G,
+                              ContactSolution& solution);
+  /// The local form (FCLIB): validates the problem, then solves; `lambda` is the initial guess on
+  /// entry (empty means zero) and the result on return. after_iteration gets an empty u.
+  SolverResult solve(const LocalProblem& problem, std::vector<Vector3>& lambda);
+
+  const SolverOptions& options() const { return options_; }  ///< the validated options
+  Method method() const { return method_; }                  ///< the method
+  const SolverHooks& hooks() const { return hooks_; }         ///< the hooks
+
+ private:
+  Method method_;
+  SolverOptions options_;
+  SolverHooks hooks_;
+  std::unique_ptr<detail::SolverWorkspace> workspace_;
+};
+
 /// \name Body-form solvers
-/// Each validates the problem and the options first (InvalidArgument), then iterates.
+/// Each validates the problem and the options first (InvalidArgument), then iterates: a
+/// ContactSolver used once.
 ///@{
 
 /// Projected Gauss–Seidel: sweeps the contacts in order with sor_contact_update().
@@ -126,7 +268,8 @@ SolverResult solve_jor(const ContactProblem& problem, ContactSolution& solution,
 /// α/L with L from a power-iteration estimate of λ_max(G), doubled by backtracking when a step
 /// fails the sufficient-decrease test and shrunk by 10 % after each accepted one; the cone
 /// offset s = μ ‖ξ_T‖ is frozen for a cycle and refreshed at every restart and at least every 25
-/// iterations (Mazhar et al. 2015 solve the convex relaxation; this solves Coulomb's law).
+/// iterations (Mazhar et al. 2015 solve the convex relaxation; this solves Coulomb's law). The
+/// numbers are the constants of namespace apgd. r_strategy does not apply.
 SolverResult solve_apgd(const ContactProblem& problem, ContactSolution& solution,
                         const SolverOptions& options = {});
 ///@}

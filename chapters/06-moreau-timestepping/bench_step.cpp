@@ -1,0 +1,99 @@
+// Chapter 6: the cost of one Moreau step of a settled sphere pile (pile.hpp), by stage.
+//
+//   BM_step/n   one step of the pile of n × n × n FCC cells (4n³ spheres, ≈ 6 contacts per
+//               sphere) at a fixed 100 SOR iterations with warm start. Counters:
+//               ns_per_body     wall time of a step per sphere
+//               detection, assembly, solve, update, midpoint   the stages, ms per step
+//               sweeps_100      100 bare sor_sweep() calls on the same problem, ms, timed in the
+//                               same run: the floor a step cannot go below
+//               step_over_sweeps   a step divided by its 100 sweeps (the target is 1.05)
+//               allocs_per_step    heap allocations (operator new) during the timed steps
+//               bytes_per_body     heap in use per sphere after the steps (mallinfo2)
+//
+// Run: ch06_bench_step [--benchmark_filter=...] (or the target run_ch06_bench_step).
+
+#include <benchmark/benchmark.h>
+#include <malloc.h>
+
+#include <chrono>
+#include <vector>
+
+#include "grbd/contact/solver.hpp"
+#include "grbd/timestep/stepper.hpp"
+#include "grbd_demo/allocation_counter.hpp"
+#include "pile.hpp"
+
+namespace {
+
+using namespace grbd;
+
+double heap_in_use() {
+  const struct mallinfo2 info = mallinfo2();
+  return static_cast<double>(info.uordblks + info.hblkhd);
+}
+
+void BM_step(benchmark::State& state) {
+  const int n = static_cast<int>(state.range(0));
+  const double heap_before = heap_in_use();
+  timestep::BodySystem system;
+  timestep::StaticGeometry statics;
+  demo::fcc_pile(system, statics, n, n, n);
+  const timestep::MaterialTable materials = demo::glass_materials();
+  timestep::StepSettings settings;
+  settings.dt = 2e-4;
+  settings.solver.min_iterations = 100;
+  settings.solver.max_iterations = 100;
+  timestep::MoreauStepper stepper(system, statics, materials, settings);
+  for (int warm = 0; warm < 3; ++warm) stepper.step();  // buffers grow, warm starts fill
+
+  timestep::StepTimes sum;
+  std::size_t contacts = 0;
+  const long allocations_before = demo::allocations();
+  for (auto _ : state) {
+    const timestep::StepReport r = stepper.step();
+    sum.midpoint += r.seconds.midpoint;
+    sum.detection += r.seconds.detection;
+    sum.assembly += r.seconds.assembly;
+    sum.solve += r.seconds.solve;
+    sum.update += r.seconds.update;
+    sum.total += r.seconds.total;
+    contacts = r.contacts;
+  }
+  const long allocations = demo::allocations() - allocations_before;
+  const double steps = static_cast<double>(state.iterations());
+  const double bytes = heap_in_use() - heap_before;
+
+  // The floor: 100 bare sweeps over the same problem, in the same run.
+  const contact::ContactProblem& problem = stepper.problem();
+  const std::vector<contact::RFactors> r =
+      contact::r_factors(problem, contact::RFactorStrategy::per_contact, 1.0);
+  std::vector<Vector6> u = problem.u_free;
+  std::vector<Vector3> lambda(problem.contacts.size(), Vector3::Zero());
+  const auto t0 = std::chrono::steady_clock::now();
+  for (int k = 0; k < 100; ++k) {
+    contact::sor_sweep(problem, r, contact::ProxForm::alart_curnier, u, lambda);
+  }
+  benchmark::DoNotOptimize(lambda.data());
+  const double sweeps = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+
+  const auto N = static_cast<double>(system.size());
+  state.counters["spheres"] = N;
+  state.counters["contacts"] = static_cast<double>(contacts);
+  state.counters["ns_per_body"] = 1e9 * sum.total / steps / N;
+  state.counters["midpoint_ms"] = 1e3 * sum.midpoint / steps;
+  state.counters["detection_ms"] = 1e3 * sum.detection / steps;
+  state.counters["assembly_ms"] = 1e3 * sum.assembly / steps;
+  state.counters["solve_ms"] = 1e3 * sum.solve / steps;
+  state.counters["update_ms"] = 1e3 * sum.update / steps;
+  state.counters["sweeps_100_ms"] = 1e3 * sweeps;
+  state.counters["step_over_sweeps"] = sum.total / steps / sweeps;
+  state.counters["allocs_per_step"] = static_cast<double>(allocations) / steps;
+  state.counters["bytes_per_body"] = bytes / N;
+}
+
+BENCHMARK(BM_step)->Arg(6)->Arg(14)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_step)->Arg(29)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(3);
+
+}  // namespace
+
+BENCHMARK_MAIN();

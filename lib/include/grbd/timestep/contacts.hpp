@@ -1,0 +1,95 @@
+#pragma once
+/// \file
+/// \brief The contacts of a system of bodies (chapter 6): detection at given states in a
+/// canonical order, contact identities built from global ids, and warm starts kept in flat arrays
+/// with an open-addressing index.
+
+#include <compare>
+#include <cstddef>
+#include <cstdint>
+#include <span>
+#include <utility>
+#include <vector>
+
+#include "grbd/collision/broad_phase.hpp"
+#include "grbd/collision/contact.hpp"
+#include "grbd/timestep/body_system.hpp"
+
+namespace grbd::timestep {
+
+/// The identity of a contact, independent of where the bodies are stored: the global ids of the
+/// two sides (a static object's id tagged with kStaticTag) and their features. Side a is the
+/// first in the order sphere, box, capsule, half-space, mesh and, between two sides of the same
+/// kind, the one with the smaller id; so reordering, removal, restart and (chapter 8) migration
+/// keep every key.
+struct ContactKey {
+  std::uint64_t a = 0;          ///< global id of side a (kStaticTag | id for a static object)
+  std::uint64_t b = 0;          ///< global id of side b
+  std::uint64_t feature_a = 0;  ///< feature of a (collision::face_feature() and others)
+  std::uint64_t feature_b = 0;  ///< feature of b
+  /// Lexicographic in (a, b, feature_a, feature_b).
+  friend auto operator<=>(const ContactKey&, const ContactKey&) = default;
+};
+
+/// Contact detection for a BodySystem and its StaticGeometry. Every buffer is a member and keeps
+/// its capacity, so that detection in a settled system allocates nothing.
+///
+/// Pairs of spheres go through the CellGrid of chapter 4; boxes and capsules meet the other
+/// bodies whose bounding spheres they touch; every dynamic body meets every static object.
+/// Fixed bodies meet dynamic ones only. The contacts come out in a canonical order: along the
+/// Morton curve of their points, ties broken by key, so that the order, and everything the
+/// solver computes from it, does not depend on how the bodies are stored.
+class ContactDetector {
+ public:
+  /// All contacts with g_N ≤ margin at the states of `system`, each with its tangent basis and
+  /// lever arms, and their keys (same length); both vectors are overwritten. A fixed body enters
+  /// its contacts as collision::kStatic (it does not move), with its global id in the key. The
+  /// collider fields of the contacts hold −1 (body sides) or the static object's index.
+  void detect(const BodySystem& system, const StaticGeometry& statics, double margin,
+              std::vector<collision::Contact>& contacts, std::vector<ContactKey>& keys);
+
+ private:
+  collision::CellGrid grid_;
+  std::vector<Vector3> centres_;
+  std::vector<double> radii_;
+  std::vector<std::int32_t> sphere_bodies_;
+  std::vector<collision::IndexPair> pairs_;
+  std::vector<std::size_t> others_;  // dynamic non-spheres and fixed bodies
+  std::vector<collision::Placement> placements_;
+  std::vector<collision::ContactGeometry> found_;
+  std::vector<collision::Contact> unsorted_;
+  std::vector<ContactKey> unsorted_keys_;
+  std::vector<std::pair<std::uint64_t, std::uint32_t>> order_;
+};
+
+/// The percussions of the previous step, keyed by ContactKey, in flat arrays: store() copies
+/// keys and percussions and rebuilds an open-addressing index (linear probing, load ≤ 1/2);
+/// initialize() looks every key up in O(1) expected. Once the arrays have grown to the largest
+/// contact count, neither allocates.
+class WarmStartTable {
+ public:
+  /// Replaces what is stored (same lengths, else InvalidArgument). A key given twice keeps the
+  /// last percussion.
+  void store(std::span<const ContactKey> keys, std::span<const Vector3> lambda);
+  /// Writes the stored percussion of each key into `lambda` (same length as keys, else
+  /// InvalidArgument), zero for a new contact; returns how many keys were found.
+  std::size_t initialize(std::span<const ContactKey> keys, std::span<Vector3> lambda) const;
+  /// The stored keys and percussions (for checkpoints, chapter 7).
+  std::span<const ContactKey> keys() const { return keys_; }     ///< the stored keys
+  std::span<const Vector3> lambda() const { return lambda_; }     ///< their percussions
+  /// Number of stored contacts.
+  std::size_t size() const { return keys_.size(); }
+  /// Forgets everything (keeps the capacity).
+  void clear();
+
+ private:
+  std::size_t find(const ContactKey& key) const;  // index into keys_, or size()
+  std::vector<ContactKey> keys_;
+  std::vector<Vector3> lambda_;
+  std::vector<std::uint32_t> slots_;  // index + 1, 0 = empty
+};
+
+/// A 64-bit hash of a key (splitmix64 finalisers of its four words).
+std::uint64_t hash(const ContactKey& key);
+
+}  // namespace grbd::timestep

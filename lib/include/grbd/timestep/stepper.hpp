@@ -1,0 +1,160 @@
+#pragma once
+/// \file
+/// \brief Moreau's midpoint time-stepping scheme for a system of bodies (chapter 6; Moreau 1988,
+/// Jean 1999): half step to the midpoint, collision detection there, the contact problem in
+/// percussions with Newton's impact law and a warm start, the end-of-step velocities and the
+/// second half step.
+
+#include <cstddef>
+#include <cstdint>
+#include <functional>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "grbd/collision/contact.hpp"
+#include "grbd/contact/problem.hpp"
+#include "grbd/contact/solver.hpp"
+#include "grbd/timestep/body_system.hpp"
+#include "grbd/timestep/contacts.hpp"
+#include "grbd/timestep/materials.hpp"
+
+namespace grbd::timestep {
+
+/// What a step does when the contact solver stops at max_iterations without meeting its
+/// tolerance. Divergence (a non-finite iterate) always throws: a NaN is never carried on.
+enum class NonConvergence {
+  count,  ///< count it in the report and the stepper's total, and go on
+  warn,   ///< as count, and print one line to stderr
+  stop,   ///< throw grbd::Error naming the step, time, iterations and residual
+};
+
+/// How the two half steps move the orientation.
+enum class OrientationUpdate {
+  exponential_map,    ///< p ← p exp_S3(Δt/4 ω): stays on |p| = 1 (half_step())
+  add_and_normalize,  ///< p ← (p + Δt/4 p∘(0, ω))/|…| (the lecture's and GRSFramework's variant)
+};
+
+/// Settings of the stepper; MoreauStepper refuses (InvalidArgument) values outside their ranges.
+struct StepSettings {
+  double dt = 1e-4;                          ///< time step Δt [s] > 0
+  Vector3 I_g = Vector3(0.0, 0.0, -9.81);    ///< gravity in frame I [m/s²], any direction
+  contact::Method method = contact::Method::sor;  ///< the contact solver
+  contact::SolverOptions solver;             ///< its options
+  bool warm_start = true;                    ///< start each solve from the last step's percussions
+  /// Reorder the bodies along the Morton curve every this many steps (0: never).
+  int reorder_interval = 0;
+  NonConvergence on_non_convergence = NonConvergence::count;  ///< see NonConvergence
+  OrientationUpdate orientation_update = OrientationUpdate::exponential_map;  ///< half steps
+  /// A contact is active when g_N(q_M) ≤ contact_tolerance × the smallest body radius: Moreau's
+  /// g_N ≤ 0 made robust against round-off, which otherwise opens the corners of a box resting
+  /// on a face by 10⁻¹⁷ m and lets it rock. ≥ 0 and finite.
+  double contact_tolerance = 1e-9;
+  /// Penetration drift correction β ∈ [0, 1] (0: off, the default): after the step, each active
+  /// contact with g_N(q_M) < 0 pushes its bodies apart by β|g_N| along the normal (positions
+  /// only, velocities untouched), shared by inverse mass and divided among the contacts of a body.
+  double drift_correction = 0.0;
+};
+
+/// Wall time of the stages of one step [s].
+struct StepTimes {
+  double midpoint = 0.0;   ///< first half step, free velocities
+  double detection = 0.0;  ///< collision detection at q_M
+  double assembly = 0.0;   ///< W, γ_S, G_ii, materials, warm start
+  double solve = 0.0;      ///< the contact solver
+  double update = 0.0;     ///< end velocities, second half step, warm-start store, energies
+  double total = 0.0;      ///< the whole step
+};
+
+/// What one step did.
+struct StepReport {
+  std::uint64_t step = 0;         ///< number of this step (1 for the first)
+  double t = 0.0;                 ///< time at the end of the step [s]
+  std::size_t contacts = 0;       ///< active contacts
+  std::size_t warm_started = 0;   ///< contacts that found a percussion of the previous step
+  int iterations = 0;             ///< solver iterations
+  double residual = 0.0;          ///< natural-map residual of the returned percussions
+  bool converged = true;          ///< the solver met its tolerance (true without contacts)
+  double kinetic_energy = 0.0;    ///< at the end of the step [J]
+  double potential_energy = 0.0;  ///< −Σ m I_gᵀ I_r_S at the end of the step [J]
+  double max_penetration = 0.0;   ///< max(0, −g_N) over the contacts at the midpoint [m]
+  StepTimes seconds;              ///< stage timings
+};
+
+/// Loads on the bodies besides gravity, evaluated at the midpoint: called once per step with the
+/// time t_M, the system at q_M (velocities u_S) and one Loads per body, zeroed, to add to.
+using ExternalLoads =
+    std::function<void(double t_M, const BodySystem& system, std::span<body::Loads> loads)>;
+
+/// Moreau's midpoint scheme for a BodySystem among a StaticGeometry, with per-pair materials.
+///
+/// The stepper keeps references to the three (they must outlive it) and owns every buffer of a
+/// step; after the first steps, a step of a settled system allocates nothing. Bodies may be
+/// added or removed between steps; the stepper notices (BodySystem::layout_version) and checks
+/// the materials and shapes of the new layout once.
+class MoreauStepper {
+ public:
+  /// Checks the settings, that every pair of materials in use has a law (naming both
+  /// materials), and that every pair of shapes that can meet is supported.
+  MoreauStepper(BodySystem& system, const StaticGeometry& statics, const MaterialTable& materials,
+                StepSettings settings = {});
+
+  /// One step of length Δt; returns its report. Throws grbd::Error when the solver diverges or
+  /// (NonConvergence::stop) does not converge; the system is then left at the midpoint state.
+  StepReport step();
+
+  /// Time [s] at the end of the last step.
+  double time() const { return t_; }
+  /// Number of steps done.
+  std::uint64_t steps() const { return steps_; }
+  /// Sets the clock (restart).
+  void set_clock(double t, std::uint64_t steps);
+  /// Steps that did not converge so far.
+  std::uint64_t non_converged_steps() const { return non_converged_; }
+
+  /// Loads besides gravity (empty: none).
+  ExternalLoads external_loads;
+  /// The settings.
+  const StepSettings& settings() const { return settings_; }
+
+  /// \name The last step
+  /// Contacts (at the midpoint, canonical order), their keys and percussions, and the contact
+  /// problem that was solved.
+  ///@{
+  std::span<const collision::Contact> contacts() const { return contacts_; }  ///< at q_M
+  std::span<const ContactKey> keys() const { return keys_; }  ///< one per contact
+  std::span<const Vector3> percussions() const { return solution_.lambda; }  ///< λ per contact
+  const contact::ContactProblem& problem() const { return problem_; }  ///< the problem solved
+  ///@}
+  /// The warm starts (chapter 7 saves and restores them).
+  WarmStartTable& warm_starts() { return warm_; }
+
+ private:
+  void check_layout();
+  void correct_drift();
+
+  BodySystem& system_;
+  const StaticGeometry& statics_;
+  const MaterialTable& materials_;
+  StepSettings settings_;
+  contact::ContactSolver solver_;
+  ContactDetector detector_;
+  WarmStartTable warm_;
+  double t_ = 0.0;
+  std::uint64_t steps_ = 0;
+  std::uint64_t non_converged_ = 0;
+  std::uint64_t checked_layout_ = ~std::uint64_t{0};
+  double tolerance_ = 0.0;  // contact_tolerance × the smallest bounding radius [m]
+
+  std::vector<body::Loads> loads_;
+  std::vector<collision::Contact> contacts_;
+  std::vector<ContactKey> keys_;
+  contact::ContactProblem problem_;
+  std::vector<Matrix3> G_;
+  contact::ContactSolution solution_;
+  std::vector<Vector3> shift_;      // drift correction: displacement per body
+  std::vector<std::uint32_t> share_;  // drift correction: contacts per body
+};
+
+}  // namespace grbd::timestep

@@ -1,0 +1,595 @@
+/// \file
+/// \brief Moreau's midpoint scheme through the real stepper, against the closed forms of
+/// non-smooth mechanics (../shared/REFERENCES.md; Glocker 2001 for the cradle, Stewart 2000 for
+/// Painlevé), conservation laws, and the identity of contacts under reordering.
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <numbers>
+#include <numeric>
+#include <random>
+#include <vector>
+
+#include "grbd/core/error.hpp"
+#include "grbd/kinematics/rotation.hpp"
+#include "grbd/timestep/midpoint.hpp"
+#include "grbd/timestep/stepper.hpp"
+#include "scenes.hpp"
+
+namespace grbd::timestep {
+namespace {
+
+using test::sphere_body;
+
+constexpr double kG = 9.81;
+constexpr double kEps = std::numeric_limits<double>::epsilon();
+
+/// Tight solver settings for the closed-form checks.
+StepSettings tight(double dt) {
+  StepSettings s;
+  s.dt = dt;
+  s.solver.abs_tol = 1e-15;
+  s.solver.rel_tol = 1e-12;
+  s.solver.max_iterations = 100000;
+  s.on_non_convergence = NonConvergence::stop;
+  return s;
+}
+
+// ---------------------------------------------------------------------------------------------
+// The bouncing ball: impacts at t_k = t₁ (1 + 2ε + … + 2ε^(k−1)), rest after the Zeno time.
+
+struct Bounce {
+  std::vector<double> impacts;  // start time of each step with an approaching contact
+  double rest_from = -1.0;      // from this time on u = 0 to round-off (−1: never)
+  bool energy_increased = false;
+  double worst_gain = 0.0;
+};
+
+Bounce bounce(double eps, double dt, double t_end) {
+  BodySystem system;
+  const double r = 0.1;
+  const double h0 = 1.0;
+  system.add(sphere_body(1, r, Vector3(0.0, 0.0, r + h0)));
+  StaticGeometry statics;
+  statics.add(test::floor_object());
+  const MaterialTable materials = test::one_material(0.3, eps);
+  MoreauStepper stepper(system, statics, materials, tight(dt));
+  Bounce result;
+  double energy = mechanical_energy(system.inertia(), system.states(), stepper.settings().I_g);
+  const double scale = std::abs(energy);
+  bool resting = false;
+  while (stepper.time() < t_end) {
+    const double t = stepper.time();
+    const double v_before = system.states()[0].u.z();
+    const StepReport report = stepper.step();
+    if (report.contacts > 0 && v_before < 0.0 && stepper.percussions()[0].x() > 0.0 &&
+        system.states()[0].u.z() > 0.0) {
+      result.impacts.push_back(t);
+    }
+    const double e = report.kinetic_energy + report.potential_energy;
+    if (e > energy + 1e-13 * scale) {
+      result.energy_increased = true;
+      result.worst_gain = std::max(result.worst_gain, (e - energy) / scale);
+    }
+    energy = e;
+    // At rest the velocity is zero to the round-off of the velocity change g Δt of one step
+    // (the percussion m g Δt cancels it within a few ulps, ≈ 3·10⁻¹⁸ m/s here).
+    const bool at_rest = system.states()[0].u.norm() <= 4.0 * kEps * kG * dt &&
+                         system.states()[0].u.head<2>() == Vector2::Zero() &&
+                         system.states()[0].u.tail<3>() == Vector3::Zero();
+    if (at_rest && !resting) result.rest_from = stepper.time();
+    if (!at_rest) result.rest_from = -1.0;
+    resting = at_rest;
+  }
+  return result;
+}
+
+TEST(BouncingBall, ImpactTimesWithinKPlusOneStepsOfTheClosedFormAndRestAfterZeno) {
+  const double dt = 1e-3;
+  for (const double eps : {0.8, 0.5}) {
+    const double zeno = bouncing_ball_zeno_time(1.0, kG, eps);
+    const Bounce b = bounce(eps, dt, zeno + 0.5);
+    ASSERT_GE(b.impacts.size(), 6u) << "eps " << eps;
+    for (std::size_t k = 1; k <= 6; ++k) {
+      const double expected = bouncing_ball_impact_time(static_cast<int>(k), 1.0, kG, eps);
+      EXPECT_LE(std::abs(b.impacts[k - 1] - expected), double(k + 1) * dt)
+          << "eps " << eps << ", impact " << k << ": " << b.impacts[k - 1] << " vs " << expected;
+    }
+    // At rest (u = 0 to round-off) soon after the Zeno time: once the flights are shorter than
+    // Δt, the last closing velocity, at most g Δt, is restituted and reversed in turn (a
+    // separating active contact takes ε = 1), shrinking by ε every two steps, so it reaches the
+    // round-off ε_mach g Δt within 2 ln(ε_mach)/ln(ε) steps.
+    ASSERT_GE(b.rest_from, 0.0) << "eps " << eps;
+    const double settle = (2.0 * std::log(kEps) / std::log(eps) + 20.0) * dt;
+    EXPECT_LE(b.rest_from, zeno + settle) << "eps " << eps;
+    EXPECT_GE(b.rest_from, zeno - 2.0 * dt) << "eps " << eps;
+    EXPECT_FALSE(b.energy_increased) << "eps " << eps << ": relative gain " << b.worst_gain;
+  }
+}
+
+TEST(BouncingBall, MechanicalEnergyNeverIncreases) {
+  for (const double eps : {0.0, 0.3, 1.0}) {
+    const Bounce b = bounce(eps, 1e-3, 2.0);
+    EXPECT_FALSE(b.energy_increased) << "eps " << eps << ": relative gain " << b.worst_gain;
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Block and sphere on an incline: gravity tilted by θ about y, the floor z = 0.
+
+Vector3 tilted_gravity(double theta) {
+  return kG * Vector3(std::sin(theta), 0.0, -std::cos(theta));
+}
+
+struct Slide {
+  double x = 0.0;  // displacement along the slope after t_end
+  double v = 0.0;  // velocity along the slope
+  double omega_y = 0.0;
+};
+
+Slide incline(const BodySpec& spec, double theta, double mu, double t_end, double dt = 1e-3) {
+  BodySystem system;
+  system.add(spec);
+  StaticGeometry statics;
+  statics.add(test::floor_object());
+  const MaterialTable materials = test::one_material(mu);
+  StepSettings settings = tight(dt);
+  settings.I_g = tilted_gravity(theta);
+  MoreauStepper stepper(system, statics, materials, settings);
+  const double x0 = system.states()[0].q.x();
+  while (stepper.time() < t_end - 0.5 * dt) stepper.step();
+  return {system.states()[0].q.x() - x0, system.states()[0].u.x(), system.states()[0].u(4)};
+}
+
+TEST(Incline, ABlockSticksJustBelowTheFrictionAngleAndSlidesJustAbove) {
+  const double mu = 0.5;
+  const double theta_c = std::atan(mu);
+  const double delta = 0.1 * std::numbers::pi / 180.0;
+  const Vector3 h(0.1, 0.1, 0.05);
+  const BodySpec block = test::box_body(1, h, Vector3(0.0, 0.0, h.z()));
+  const double t = 1.0;
+  const Slide stick = incline(block, theta_c - delta, mu, t);
+  EXPECT_LE(std::abs(stick.x), 1e-12) << "creep below the friction angle";
+  EXPECT_LE(std::abs(stick.v), 1e-12);
+  const double theta = theta_c + delta;
+  const double a = kG * (std::sin(theta) - mu * std::cos(theta));
+  const Slide slide = incline(block, theta, mu, t);
+  EXPECT_NEAR(slide.v, a * t, 1e-9 * a * t) << "a = g (sin θ − μ cos θ)";
+  EXPECT_NEAR(slide.x, 0.5 * a * t * t, 1e-9 * a * t * t);
+}
+
+TEST(Incline, ASphereRollsIffFrictionSufficesElseSlides) {
+  const double r = 0.05;
+  const BodySpec ball = sphere_body(1, r, Vector3(0.0, 0.0, r));
+  const double theta = 20.0 * std::numbers::pi / 180.0;
+  const double mu_roll = 2.0 / 7.0 * std::tan(theta);
+  const double t = 1.0;
+  // Rolling: a = 5/7 g sin θ, and ω R = v.
+  const Slide roll = incline(ball, theta, 1.05 * mu_roll, t);
+  const double a_roll = 5.0 / 7.0 * kG * std::sin(theta);
+  EXPECT_NEAR(roll.v, a_roll * t, 1e-9 * a_roll * t);
+  EXPECT_NEAR(roll.omega_y * r, roll.v, 1e-9 * roll.v);
+  // Sliding: a = g (sin θ − μ cos θ), and the spin lags behind.
+  const double mu = 0.95 * mu_roll;
+  const Slide slip = incline(ball, theta, mu, t);
+  const double a_slip = kG * (std::sin(theta) - mu * std::cos(theta));
+  EXPECT_NEAR(slip.v, a_slip * t, 1e-9 * a_slip * t);
+  EXPECT_LT(slip.omega_y * r, 0.99 * slip.v);
+}
+
+// ---------------------------------------------------------------------------------------------
+
+TEST(BilliardBall, RollingStartsAtTwoV0Over7MuGWithFiveSeventhsOfTheSpeed) {
+  const double r = 0.0286;  // a pool ball
+  const double v0 = 2.0;
+  const double mu = 0.2;
+  const double dt = 1e-4;
+  BodySystem system;
+  Vector6 u0 = Vector6::Zero();
+  u0(0) = v0;
+  system.add(sphere_body(1, r, Vector3(0.0, 0.0, r), u0, 1700.0));
+  StaticGeometry statics;
+  statics.add(test::floor_object());
+  const MaterialTable materials = test::one_material(mu);
+  MoreauStepper stepper(system, statics, materials, tight(dt));
+  const double t_star = 2.0 * v0 / (7.0 * mu * kG);
+  double t_roll = -1.0;
+  while (stepper.time() < 1.5 * t_star) {
+    stepper.step();
+    const Vector6& u = system.states()[0].u;
+    const double slip = u(0) - u(4) * r;  // velocity of the contact point along x
+    if (t_roll < 0.0 && std::abs(slip) <= 1e-9 * v0) t_roll = stepper.time();
+  }
+  ASSERT_GT(t_roll, 0.0);
+  EXPECT_LE(std::abs(t_roll - t_star), dt) << "t* = 2 v0/(7 μ g)";
+  EXPECT_NEAR(system.states()[0].u(0), 5.0 / 7.0 * v0, 1e-9 * v0);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Newton's cradle: N touching balls, the first moving; Moreau's simultaneous impact law
+// (Glocker 2001) gives the striker (2 − N)/N v₀ and the others 2/N v₀ for ε = 1, v₀/N for all
+// for ε = 0.
+
+std::vector<double> cradle(int N, double eps) {
+  BodySystem system;
+  const double r = 0.0625;  // centres 2r i exact in binary: the balls touch, g_N = 0 exactly
+  for (int i = 0; i < N; ++i) {
+    Vector6 u = Vector6::Zero();
+    if (i == 0) u(0) = 1.0;
+    system.add(sphere_body(static_cast<GlobalId>(i + 1), r, Vector3(2.0 * r * i, 0.0, 1.0), u));
+  }
+  StaticGeometry statics;
+  const MaterialTable materials = test::one_material(0.0, eps);
+  StepSettings settings = tight(1e-4);
+  settings.I_g.setZero();
+  MoreauStepper stepper(system, statics, materials, settings);
+  const StepReport report = stepper.step();
+  EXPECT_EQ(report.contacts, static_cast<std::size_t>(N - 1));
+  std::vector<double> v;
+  for (std::size_t i = 0; i < system.size(); ++i) v.push_back(system.states()[i].u.x());
+  return v;
+}
+
+TEST(NewtonsCradle, SimultaneousImpactLawOfMoreau) {
+  const std::vector<double> elastic = cradle(3, 1.0);
+  EXPECT_NEAR(elastic[0], -1.0 / 3.0, 1e-10);
+  EXPECT_NEAR(elastic[1], 2.0 / 3.0, 1e-10);
+  EXPECT_NEAR(elastic[2], 2.0 / 3.0, 1e-10);
+  for (const int N : {3, 5}) {
+    const std::vector<double> plastic = cradle(N, 0.0);
+    for (const double v : plastic) EXPECT_NEAR(v, 1.0 / N, 1e-10) << "N = " << N;
+  }
+  const std::vector<double> five = cradle(5, 1.0);
+  EXPECT_NEAR(five[0], -3.0 / 5.0, 1e-10);
+  for (int i = 1; i < 5; ++i) EXPECT_NEAR(five[static_cast<std::size_t>(i)], 2.0 / 5.0, 1e-10);
+}
+
+// ---------------------------------------------------------------------------------------------
+
+TEST(SphereColumn, PercussionKMgDtAtTheKthContactFromTheTopAndNoDrift) {
+  const int N = 8;
+  const double r = 0.01;
+  const double dt = 1e-3;
+  BodySystem system;
+  for (int i = 0; i < N; ++i) {
+    system.add(sphere_body(static_cast<GlobalId>(i + 1), r, Vector3(0.0, 0.0, r + 2.0 * r * i)));
+  }
+  StaticGeometry statics;
+  statics.add(test::floor_object());
+  const MaterialTable materials = test::one_material(0.5);
+  MoreauStepper stepper(system, statics, materials, tight(dt));
+  const double m = system.inertia()[0].m;
+  std::vector<Vector7> q0;
+  for (const body::State& s : system.states()) q0.push_back(s.q);
+  for (int step = 0; step < 1000; ++step) {
+    const StepReport report = stepper.step();
+    ASSERT_EQ(report.contacts, static_cast<std::size_t>(N));
+    // The k-th contact from the top carries k m g Δt; find it by its key.
+    for (std::size_t c = 0; c < report.contacts; ++c) {
+      const ContactKey& key = stepper.keys()[c];
+      // The contact below body with id j (floor: below id 1) carries the N − j + 1 bodies above.
+      const GlobalId upper = (key.b & kStaticTag) ? key.a : std::max(key.a, key.b);
+      const double k = double(N) - double(upper) + 1.0;
+      EXPECT_NEAR(stepper.percussions()[c].x(), k * m * kG * dt, 1e-9 * k * m * kG * dt)
+          << "step " << step << ", contact below body " << upper;
+    }
+  }
+  for (std::size_t i = 0; i < system.size(); ++i) {
+    EXPECT_LE((system.states()[i].q - q0[i]).norm(), 1e-12) << "body " << i << " drifted";
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Three spheres: two on the floor touching, one on top. The friction needed between the spheres
+// is 2 − √3 and on the floor (2 − √3)/3.
+
+double pyramid_sag(double mu_spheres, double mu_floor) {
+  const double r = 0.05;
+  BodySystem system;
+  MaterialTable materials;
+  const MaterialId ball = materials.add("ball");
+  const MaterialId ground = materials.add("ground");
+  materials.set_pair(ball, ball, {mu_spheres, 0.0, 0.0});
+  materials.set_pair(ball, ground, {mu_floor, 0.0, 0.0});
+  system.add(sphere_body(1, r, Vector3(-r, 0.0, r), Vector6::Zero(), 2500.0, ball));
+  system.add(sphere_body(2, r, Vector3(r, 0.0, r), Vector6::Zero(), 2500.0, ball));
+  system.add(
+      sphere_body(3, r, Vector3(0.0, 0.0, r + std::sqrt(3.0) * r), Vector6::Zero(), 2500.0, ball));
+  StaticGeometry statics;
+  statics.add(test::floor_object(0, ground));
+  MoreauStepper stepper(system, statics, materials, tight(1e-3));
+  const double z0 = system.states()[2].q.z();
+  while (stepper.time() < 0.5) stepper.step();
+  return z0 - system.states()[2].q.z();
+}
+
+TEST(ThreeSpheres, StayIffFrictionReachesTwoMinusRootThree) {
+  const double need_spheres = 2.0 - std::sqrt(3.0);
+  const double need_floor = need_spheres / 3.0;
+  EXPECT_LE(pyramid_sag(1.02 * need_spheres, 1.02 * need_floor), 1e-10);
+  EXPECT_GT(pyramid_sag(0.98 * need_spheres, 1.02 * need_floor), 1e-3);
+  EXPECT_GT(pyramid_sag(1.02 * need_spheres, 0.98 * need_floor), 1e-3);
+}
+
+// ---------------------------------------------------------------------------------------------
+
+struct RodRun {
+  std::uint64_t non_converged = 0;
+  int steps_with_contact = 0;
+  double worst_gain = 0.0;  // largest relative energy increase of one step
+  bool finite = true;
+};
+
+RodRun painleve_rod(contact::Method method) {
+  // A uniform rod (a capsule of half length l) leaning at 45° and sliding with μ = 1.5 > 4/3, the
+  // Painlevé window of a rod (k = m l²/I = 3: μ > 2√(1 + k)/k), where the acceleration-level
+  // problem may have no solution or two (Stewart 2000); the velocity-level step always has one.
+  const double l = 0.5;
+  const double r = 0.01;
+  const double m = 1.0;
+  const double tilt = std::numbers::pi / 4.0;
+  BodySpec rod;
+  rod.id = 1;
+  rod.shape = collision::Capsule{r, l};
+  rod.inertia = {m, Vector3(m * l * l / 3.0, m * l * l / 3.0, 1e-3 * m * r * r)};
+  // The lower end just touches the floor.
+  rod.state.q << (r + l * std::cos(tilt)) * Vector3::UnitZ(),
+      kinematics::quaternion_from_axis_angle(Vector3::UnitY(), tilt).coeffs();
+  rod.state.u << -2.0, 0.0, 0.0, 0.0, 0.0, 0.0;
+  BodySystem system;
+  system.add(rod);
+  StaticGeometry statics;
+  statics.add(test::floor_object());
+  const MaterialTable materials = test::one_material(1.5);
+  StepSettings settings;
+  settings.dt = 1e-4;
+  settings.method = method;
+  settings.on_non_convergence = NonConvergence::count;
+  MoreauStepper stepper(system, statics, materials, settings);
+  RodRun run;
+  double energy = 0.0;
+  bool first = true;
+  while (stepper.time() < 0.3) {
+    const StepReport report = stepper.step();
+    const double e = report.kinetic_energy + report.potential_energy;
+    if (!first) run.worst_gain = std::max(run.worst_gain, (e - energy) / std::abs(energy));
+    energy = e;
+    first = false;
+    if (report.contacts > 0) ++run.steps_with_contact;
+    run.finite = run.finite && system.states()[0].q.allFinite() && system.states()[0].u.allFinite();
+  }
+  run.non_converged = stepper.non_converged_steps();
+  return run;
+}
+
+TEST(Painleve, ARodSlidingOnARoughFloorKeepsGoing) {
+  // APGD solves every step of the slide to its tolerance; the energy never grows beyond it.
+  const RodRun apgd = painleve_rod(contact::Method::apgd);
+  EXPECT_TRUE(apgd.finite);
+  EXPECT_GT(apgd.steps_with_contact, 100);
+  EXPECT_EQ(apgd.non_converged, 0u);
+  EXPECT_LT(apgd.worst_gain, 1e-7);
+  // SOR's fixed point of this single, strongly coupled contact cycles in many steps: the stepper
+  // counts them and goes on (NonConvergence::count), with a finite state throughout.
+  const RodRun sor = painleve_rod(contact::Method::sor);
+  EXPECT_TRUE(sor.finite);
+  EXPECT_GT(sor.steps_with_contact, 100);
+  std::printf("Painleve rod: %llu of 3000 SOR steps stopped at max_iterations\n",
+              static_cast<unsigned long long>(sor.non_converged));
+}
+
+// ---------------------------------------------------------------------------------------------
+
+TEST(Conservation, MomentumOfCollidingSpheresWithoutGravityToRoundOff) {
+  BodySystem system;
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> x(0.0, 0.2);
+  std::normal_distribution<double> v;
+  for (GlobalId id = 1; id <= 200; ++id) {
+    Vector6 u;
+    u << v(rng), v(rng), v(rng), 10.0 * v(rng), 10.0 * v(rng), 10.0 * v(rng);
+    system.add(sphere_body(id, 0.01, Vector3(x(rng), x(rng), x(rng)), u));
+  }
+  StaticGeometry statics;
+  const MaterialTable materials = test::one_material(0.4, 0.5, 0.0);
+  StepSettings settings = tight(1e-3);
+  settings.I_g.setZero();
+  settings.solver.max_iterations = 1000;
+  settings.on_non_convergence = NonConvergence::count;
+  MoreauStepper stepper(system, statics, materials, settings);
+  const auto momentum = [&] {
+    Vector3 p = Vector3::Zero();
+    for (std::size_t i = 0; i < system.size(); ++i) {
+      p += system.inertia()[i].m * system.states()[i].u.head<3>();
+    }
+    return p;
+  };
+  const Vector3 p0 = momentum();
+  double scale = 0.0;
+  for (std::size_t i = 0; i < system.size(); ++i) {
+    scale += system.inertia()[i].m * system.states()[i].u.head<3>().norm();
+  }
+  std::size_t contacts = 0;
+  for (int step = 0; step < 100; ++step) contacts += stepper.step().contacts;
+  EXPECT_GT(contacts, 100u);
+  EXPECT_LE((momentum() - p0).norm(), 1e-13 * scale);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Contacts keyed by identity: the same run with the bodies stored in another order, or reordered
+// between steps, gives the same iterations and bit-identical percussions and states.
+
+TEST(Identity, PermutingTheBodiesBetweenStepsChangesNothing) {
+  const auto setup = [](BodySystem& system, StaticGeometry& statics) {
+    test::add_open_box(statics, 0.12, 0.12);
+    test::add_sphere_lattice(system, 4, 4, 4, 0.01);
+  };
+  BodySystem a;
+  BodySystem b;
+  StaticGeometry statics;
+  StaticGeometry statics_b;
+  setup(a, statics);
+  setup(b, statics_b);
+  const MaterialTable materials = test::one_material(0.5, 0.2);
+  StepSettings settings;
+  settings.dt = 1e-3;
+  settings.solver.max_iterations = 50;
+  MoreauStepper sa(a, statics, materials, settings);
+  MoreauStepper sb(b, statics_b, materials, settings);
+  std::mt19937 rng(17);
+  std::vector<std::int32_t> order(b.size());
+  std::size_t warm = 0;
+  for (int step = 0; step < 150; ++step) {
+    std::iota(order.begin(), order.end(), 0);
+    std::shuffle(order.begin(), order.end(), rng);
+    b.permute(order);
+    const StepReport ra = sa.step();
+    const StepReport rb = sb.step();
+    ASSERT_EQ(ra.contacts, rb.contacts) << "step " << step;
+    ASSERT_EQ(ra.iterations, rb.iterations) << "step " << step;
+    ASSERT_EQ(ra.warm_started, rb.warm_started) << "step " << step;
+    warm += ra.warm_started;
+    for (std::size_t c = 0; c < ra.contacts; ++c) {
+      ASSERT_EQ(sa.keys()[c], sb.keys()[c]);
+      ASSERT_EQ(sa.percussions()[c], sb.percussions()[c]) << "step " << step << " contact " << c;
+    }
+  }
+  EXPECT_GT(warm, 1000u);
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    const std::size_t j = b.index_of(a.ids()[i]);
+    ASSERT_EQ(a.states()[i].q, b.states()[j].q);
+    ASSERT_EQ(a.states()[i].u, b.states()[j].u);
+  }
+}
+
+TEST(Identity, SameInputGivesBitIdenticalOutputAndReorderingKeepsIt) {
+  const auto run = [](int reorder_interval) {
+    BodySystem system;
+    StaticGeometry statics;
+    test::add_open_box(statics, 0.12, 0.12);
+    test::add_sphere_lattice(system, 4, 4, 4, 0.01, 3);
+    const MaterialTable materials = test::one_material(0.5, 0.2);
+    StepSettings settings;
+    settings.dt = 1e-3;
+    settings.reorder_interval = reorder_interval;
+    MoreauStepper stepper(system, statics, materials, settings);
+    for (int step = 0; step < 100; ++step) stepper.step();
+    std::vector<std::pair<GlobalId, body::State>> out;
+    for (std::size_t i = 0; i < system.size(); ++i) {
+      out.emplace_back(system.ids()[i], system.states()[i]);
+    }
+    std::sort(out.begin(), out.end(),
+              [](const auto& x, const auto& y) { return x.first < y.first; });
+    return out;
+  };
+  const auto first = run(0);
+  const auto again = run(0);
+  const auto reordered = run(7);
+  for (std::size_t i = 0; i < first.size(); ++i) {
+    ASSERT_EQ(first[i].second.q, again[i].second.q);
+    ASSERT_EQ(first[i].second.q, reordered[i].second.q);
+    ASSERT_EQ(first[i].second.u, reordered[i].second.u);
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+
+TEST(Stepper, RefusesBadSettingsMissingMaterialPairsAndUnsupportedShapePairs) {
+  BodySystem system;
+  system.add(sphere_body(1, 0.1, Vector3(0.0, 0.0, 1.0)));
+  StaticGeometry statics;
+  statics.add(test::floor_object(0, 1));
+  MaterialTable materials;
+  materials.add("ball");
+  materials.add("floor");
+  materials.set_pair(0, 0, {0.5, 0.0, 0.0});
+  try {
+    MoreauStepper stepper(system, statics, materials);
+    ADD_FAILURE() << "a missing pair was accepted";
+  } catch (const InvalidArgument& e) {
+    EXPECT_NE(std::string(e.what()).find("\"ball\" and \"floor\""), std::string::npos) << e.what();
+  }
+  materials.set_pair(0, 1, {0.5, 0.0, 0.0});
+  StepSettings bad;
+  bad.dt = 0.0;
+  EXPECT_THROW(MoreauStepper(system, statics, materials, bad), InvalidArgument);
+  bad = {};
+  bad.drift_correction = 2.0;
+  EXPECT_THROW(MoreauStepper(system, statics, materials, bad), InvalidArgument);
+  materials.set_pair(1, 1, {0.5, 0.0, 0.0});
+  system.add(test::box_body(2, Vector3(0.1, 0.1, 0.1), Vector3(1.0, 0.0, 1.0)));
+  system.add(test::box_body(3, Vector3(0.1, 0.1, 0.1), Vector3(2.0, 0.0, 1.0)));
+  try {
+    MoreauStepper stepper(system, statics, materials);
+    ADD_FAILURE() << "two dynamic boxes were accepted";
+  } catch (const InvalidArgument& e) {
+    EXPECT_NE(std::string(e.what()).find("box"), std::string::npos) << e.what();
+  }
+}
+
+TEST(Stepper, ReportsEnergiesPenetrationAndStageTimes) {
+  BodySystem system;
+  system.add(sphere_body(1, 0.1, Vector3(0.0, 0.0, 0.09)));  // 1 cm into the floor
+  StaticGeometry statics;
+  statics.add(test::floor_object());
+  const MaterialTable materials = test::one_material(0.5);
+  MoreauStepper stepper(system, statics, materials, tight(1e-3));
+  const StepReport r = stepper.step();
+  EXPECT_EQ(r.step, 1u);
+  EXPECT_DOUBLE_EQ(r.t, 1e-3);
+  EXPECT_EQ(r.contacts, 1u);
+  EXPECT_TRUE(r.converged);
+  EXPECT_NEAR(r.max_penetration, 0.01, 1e-12);
+  EXPECT_NEAR(r.potential_energy, system.inertia()[0].m * kG * system.states()[0].q.z(), 1e-12);
+  EXPECT_GE(r.seconds.total, r.seconds.solve);
+  EXPECT_GE(r.seconds.solve, 0.0);
+}
+
+TEST(DriftCorrection, OffKeepsOverlapsOnRemovesThemGeometricallyWithoutVelocity) {
+  // One sphere 0.1 mm into the floor: with β the overlap shrinks by the factor 1 − β per step.
+  const auto single = [](double beta, int steps) {
+    BodySystem system;
+    StaticGeometry statics;
+    statics.add(test::floor_object());
+    system.add(sphere_body(1, 0.01, Vector3(0.0, 0.0, 0.0099)));
+    const MaterialTable materials = test::one_material(0.5);
+    StepSettings settings = tight(1e-3);
+    settings.drift_correction = beta;
+    MoreauStepper stepper(system, statics, materials, settings);
+    for (int step = 0; step < steps; ++step) stepper.step();
+    return std::pair{0.01 - system.states()[0].q.z(), system.states()[0].u.norm()};
+  };
+  const auto [off, off_speed] = single(0.0, 50);
+  EXPECT_NEAR(off, 1e-4, 1e-12) << "the velocity-level scheme keeps the overlap";
+  EXPECT_LT(off_speed, 1e-15);
+  const auto [on, on_speed] = single(0.2, 50);
+  EXPECT_NEAR(on, 1e-4 * std::pow(0.8, 50), 1e-12);
+  EXPECT_LT(on_speed, 1e-15) << "positions only";
+  // A column of five: every overlap shrinks, none grows.
+  BodySystem system;
+  StaticGeometry statics;
+  statics.add(test::floor_object());
+  for (int i = 0; i < 5; ++i) {
+    system.add(sphere_body(static_cast<GlobalId>(i + 1), 0.01,
+                           Vector3(0.0, 0.0, 0.0099 + 0.0198 * i)));  // overlaps of 0.2 mm
+  }
+  const MaterialTable materials = test::one_material(0.5);
+  StepSettings settings = tight(1e-3);
+  settings.drift_correction = 0.2;
+  MoreauStepper stepper(system, statics, materials, settings);
+  double previous = stepper.step().max_penetration;
+  EXPECT_NEAR(previous, 2e-4, 1e-12);
+  for (int step = 0; step < 300; ++step) {
+    const double now = stepper.step().max_penetration;
+    EXPECT_LE(now, previous * (1.0 + 1e-12)) << "step " << step;
+    previous = now;
+  }
+  EXPECT_LT(previous, 5e-5);  // the overlaps diffuse through the column: 300 steps remove 3/4
+}
+
+}  // namespace
+}  // namespace grbd::timestep
