@@ -3,15 +3,13 @@
 // every stopping criterion, in the body form (solve, solve_prepared, with hooks set) and in the
 // local form.
 //
-// Reference: a counting replacement of the global operator new (all its forms). It lives in
+// Reference: a counting replacement of the global operator new, all its forms
+// (grbd_demo/allocation_counter.hpp, shared with chapter 6). It lives in
 // this executable of its own, so that it counts no other test. The counter is checked to work:
 // a std::vector of the test's own counts.
 
 #include <gtest/gtest.h>
 
-#include <atomic>
-#include <cstdlib>
-#include <new>
 #include <span>
 #include <vector>
 
@@ -20,56 +18,8 @@
 #include "grbd/contact/solver.hpp"
 #include "grbd_test/contact_problems.hpp"
 #include "grbd_test/random.hpp"
+#include "grbd_demo/allocation_counter.hpp"
 
-namespace {
-
-std::atomic<long> g_allocations{0};
-
-void* counted(std::size_t size, std::size_t alignment = 0) {
-  g_allocations.fetch_add(1, std::memory_order_relaxed);
-  if (size == 0) size = 1;
-  void* p = nullptr;
-  if (alignment > alignof(std::max_align_t)) {
-    p = std::aligned_alloc(alignment, (size + alignment - 1) / alignment * alignment);
-  } else {
-    p = std::malloc(size);
-  }
-  if (p == nullptr) throw std::bad_alloc();
-  return p;
-}
-
-}  // namespace
-
-void* operator new(std::size_t size) { return counted(size); }
-void* operator new[](std::size_t size) { return counted(size); }
-void* operator new(std::size_t size, std::align_val_t a) {
-  return counted(size, static_cast<std::size_t>(a));
-}
-void* operator new[](std::size_t size, std::align_val_t a) {
-  return counted(size, static_cast<std::size_t>(a));
-}
-void* operator new(std::size_t size, const std::nothrow_t&) noexcept {
-  try {
-    return counted(size);
-  } catch (...) {
-    return nullptr;
-  }
-}
-void* operator new[](std::size_t size, const std::nothrow_t&) noexcept {
-  try {
-    return counted(size);
-  } catch (...) {
-    return nullptr;
-  }
-}
-void operator delete(void* p) noexcept { std::free(p); }
-void operator delete[](void* p) noexcept { std::free(p); }
-void operator delete(void* p, std::size_t) noexcept { std::free(p); }
-void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
-void operator delete(void* p, std::align_val_t) noexcept { std::free(p); }
-void operator delete[](void* p, std::align_val_t) noexcept { std::free(p); }
-void operator delete(void* p, std::size_t, std::align_val_t) noexcept { std::free(p); }
-void operator delete[](void* p, std::size_t, std::align_val_t) noexcept { std::free(p); }
 
 namespace {
 
@@ -89,9 +39,9 @@ using grbd::contact::SolverResult;
 /// Heap allocations made by `call`.
 template <class F>
 long allocations_of(F&& call) {
-  const long before = g_allocations.load();
+  const long before = grbd::demo::allocations();
   call();
-  return g_allocations.load() - before;
+  return grbd::demo::allocations() - before;
 }
 
 ContactProblem random_problem(int contacts, std::uint64_t seed) {

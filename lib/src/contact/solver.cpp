@@ -413,8 +413,11 @@ class Monitor {
     for (std::size_t i = 0; i < ws_.mu.size(); ++i) ws_.mu[i] = model.mu(i);
   }
 
-  /// Call before an iteration changes Λ.
-  void before() {
+  /// Call before iteration k changes Λ. Before min_iterations the criterion is not read, so
+  /// nothing is saved: a solve at a fixed number of iterations (min = max) pays for the test
+  /// once.
+  void before(int k) {
+    if (k < options_.min_iterations) return;
     if (options_.criterion == Criterion::percussion_change) {
       const std::span<const Vector3> lambda = model_.lambda();
       ws_.lambda_old.assign(lambda.begin(), lambda.end());
@@ -436,9 +439,14 @@ class Monitor {
       return Verdict::diverged;
     }
     double residual = -1.0;
-    if (options_.record_history || options_.criterion == Criterion::natural_residual) {
+    if (options_.record_history) {
       residual = natural_residual();
-      if (options_.record_history) result_.history.push_back(residual);
+      result_.history.push_back(residual);
+    }
+    // Before min_iterations the criterion is not evaluated (before() saved nothing for it).
+    if (k < options_.min_iterations) return Verdict::not_met;
+    if (options_.criterion == Criterion::natural_residual && residual < 0.0) {
+      residual = natural_residual();
     }
     bool met = false;
     switch (options_.criterion) {
@@ -697,7 +705,7 @@ void iterate(Model& model, Policy& policy, Monitor<Model>& monitor, const Solver
   // The test sits at the end of the body: with max_iterations = INT_MAX the loop must stop
   // before ++k overflows.
   for (int k = 1;; ++k) {
-    monitor.before();
+    monitor.before(k);
     policy.iterate(k);
     if (hooks.after_iteration) {
       policy.synchronize_for_hook();

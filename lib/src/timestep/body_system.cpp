@@ -12,20 +12,12 @@
 #include "grbd/collision/broad_phase.hpp"
 #include "grbd/core/checks.hpp"
 #include "grbd/core/error.hpp"
+#include "grbd/core/hash.hpp"
 #include "grbd/kinematics/rotation.hpp"
 
 namespace grbd::timestep {
 
 namespace {
-
-/// splitmix64's finaliser: consecutive ids spread over the whole table.
-std::uint64_t mix(std::uint64_t x) {
-  x ^= x >> 30;
-  x *= 0xbf58476d1ce4e5b9ULL;
-  x ^= x >> 27;
-  x *= 0x94d049bb133111ebULL;
-  return x ^ (x >> 31);
-}
 
 /// New index i takes the element at old index order[i], in place, along the cycles of the
 /// permutation: swapping v[j] with v[order[j]] puts the right element at j and carries the
@@ -111,7 +103,7 @@ std::size_t BodySystem::add(const BodySpec& spec) {
 
 void BodySystem::insert_index(GlobalId id, std::size_t index) {
   const std::size_t mask = slots_.size() - 1;
-  std::size_t slot = mix(id) & mask;
+  std::size_t slot = mix64(id) & mask;
   while (slots_[slot] != 0) slot = (slot + 1) & mask;
   slots_[slot] = static_cast<std::uint32_t>(index + 1);
 }
@@ -126,7 +118,7 @@ void BodySystem::rebuild_index() {
 std::size_t BodySystem::index_of(GlobalId id) const {
   if (slots_.empty()) return npos;
   const std::size_t mask = slots_.size() - 1;
-  for (std::size_t slot = mix(id) & mask;; slot = (slot + 1) & mask) {
+  for (std::size_t slot = mix64(id) & mask;; slot = (slot + 1) & mask) {
     const std::uint32_t entry = slots_[slot];
     if (entry == 0) return npos;
     if (ids_[entry - 1] == id) return entry - 1;

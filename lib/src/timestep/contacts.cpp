@@ -13,20 +13,13 @@
 #include "grbd/collision/static_mesh.hpp"
 #include "grbd/core/checks.hpp"
 #include "grbd/core/error.hpp"
+#include "grbd/core/hash.hpp"
 #include "grbd/kinematics/rigid_motion.hpp"
 #include "grbd/kinematics/rotation.hpp"
 
 namespace grbd::timestep {
 
 namespace {
-
-std::uint64_t mix(std::uint64_t x) {
-  x ^= x >> 30;
-  x *= 0xbf58476d1ce4e5b9ULL;
-  x ^= x >> 27;
-  x *= 0x94d049bb133111ebULL;
-  return x ^ (x >> 31);
-}
 
 /// One side of a candidate pair: a body (by local index) or a static object (by index).
 struct Side {
@@ -37,10 +30,10 @@ struct Side {
 }  // namespace
 
 std::uint64_t hash(const ContactKey& key) {
-  std::uint64_t h = mix(key.a);
-  h = mix(h ^ key.b);
-  h = mix(h ^ key.feature_a);
-  return mix(h ^ key.feature_b);
+  std::uint64_t h = mix64(key.a);
+  h = mix64(h ^ key.b);
+  h = mix64(h ^ key.feature_a);
+  return mix64(h ^ key.feature_b);
 }
 
 // [detect system]
