@@ -1,5 +1,7 @@
 // Chapter 6: the cost of one Moreau step of a settled sphere pile (pile.hpp), by stage.
 //
+//   BM_add/N    assembling N spheres: BodySystem::add (id check, validation) and
+//               CollisionWorld::add (the supported-pair check, O(1) per collider); seconds for N.
 //   BM_step/n   one step of the pile of n × n × n FCC cells (4n³ spheres, ≈ 6 contacts per
 //               sphere) at a fixed 100 SOR iterations with warm start. Counters:
 //               ns_per_body     wall time of a step per sphere
@@ -18,6 +20,7 @@
 #include <chrono>
 #include <vector>
 
+#include "grbd/collision/world.hpp"
 #include "grbd/contact/solver.hpp"
 #include "grbd/timestep/stepper.hpp"
 #include "grbd_demo/allocation_counter.hpp"
@@ -91,6 +94,43 @@ void BM_step(benchmark::State& state) {
   state.counters["bytes_per_body"] = bytes / N;
 }
 
+void BM_add(benchmark::State& state) {
+  const auto n = static_cast<std::size_t>(state.range(0));
+  double system_seconds = 0.0;
+  double world_seconds = 0.0;
+  for (auto _ : state) {
+    timestep::BodySystem system;
+    collision::CollisionWorld world;
+    system.reserve(n);
+    world.reserve(n + 1);
+    world.add({collision::HalfSpace{}, collision::kStatic, Vector3::Zero(), Matrix3::Identity()});
+    timestep::BodySpec spec;
+    spec.state.q << 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0;
+    spec.state.u.setZero();
+    spec.inertia = {1e-5, Vector3::Constant(4e-12)};
+    spec.shape = collision::Sphere{1e-3};
+    const auto t0 = std::chrono::steady_clock::now();
+    for (std::size_t i = 0; i < n; ++i) {
+      spec.id = i;
+      spec.state.q.x() = 2e-3 * static_cast<double>(i);
+      system.add(spec);
+    }
+    const auto t1 = std::chrono::steady_clock::now();
+    for (std::size_t i = 0; i < n; ++i) {
+      world.add({collision::Sphere{1e-3}, static_cast<collision::BodyIndex>(i), Vector3::Zero(),
+                 Matrix3::Identity()});
+    }
+    const auto t2 = std::chrono::steady_clock::now();
+    system_seconds += std::chrono::duration<double>(t1 - t0).count();
+    world_seconds += std::chrono::duration<double>(t2 - t1).count();
+    benchmark::DoNotOptimize(system.size() + world.colliders().size());
+  }
+  const double runs = static_cast<double>(state.iterations());
+  state.counters["body_system_s"] = system_seconds / runs;
+  state.counters["collision_world_s"] = world_seconds / runs;
+}
+
+BENCHMARK(BM_add)->Arg(80000)->Arg(1000000)->Unit(benchmark::kMillisecond)->Iterations(1);
 BENCHMARK(BM_step)->Arg(6)->Arg(14)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_step)->Arg(29)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(3);
 
