@@ -1,0 +1,619 @@
+// Chapter 6 demo: Moreau's midpoint scheme, through the real MoreauStepper, against the closed
+// forms of non-smooth mechanics (../shared/REFERENCES.md), and a settling pile with and without
+// warm start.
+//
+// Cases (every one a BodySystem, a StaticGeometry and a MaterialTable stepped by MoreauStepper):
+//   bouncing ball  a sphere (r = 0.1 m) dropped from a gap of 1 m onto the floor, ε_N = 0.8 and
+//                  0.5, Δt = 1 ms: impact times against t_k = t₁(1 + 2ε + … + 2ε^(k−1)), the
+//                  Zeno time t₁(1 + ε)/(1 − ε), the energy after each step
+//   incline        a block (μ = 0.5) on a slope at θ_c ∓ 0.1°, θ_c = atan μ, Δt = 1 ms, 1 s:
+//                  at rest below, a = g(sin θ − μ cos θ) above; also a sphere at 20° with
+//                  μ = 1.05 and 0.95 × (2/7) tan θ: rolls with a = (5/7) g sin θ, or slides
+//   billiard       a pool ball launched sliding at v₀ = 2 m/s without spin, μ = 0.2, Δt = 0.1 ms:
+//                  rolling from t* = 2v₀/(7μg) at (5/7)v₀
+//   cradle         3 and 5 touching balls, the first moving at v₀, ε_N = 1 and 0, one step
+//   midpoint       the exp-map half step against "add and normalise" for |ω|Δt = 0.02 and 0.01
+//   Painlevé rod   a rod sliding on a rough floor (μ = 1.5 > 4/3) with APGD and with SOR
+//   pile           216 glass spheres (r = 1 mm, μ = 0.5) dropped from a jittered lattice into an
+//                  open box, settling for 0.3 s at Δt = 0.2 ms with the default solver options
+//                  (SOR, percussion change ≤ 10⁻⁶ relative, at most 1000 iterations), with and
+//                  without warm start
+// The closed-form cases use tight solver tolerances (rel_tol 1e-12), the pile the defaults.
+//
+// Output, in the data directory:
+//   bouncing_ball.csv  t, then per ε (0.8, 0.5): gap of the ball, closed-form gap, energy above
+//                      rest relative to the start
+//   impacts.csv        k, then per ε: closed-form and measured time of impact k
+//   zeno.csv           ε, closed-form Zeno time, time from which the ball rests
+//   incline.csv        t, velocity along the slope at θ_c − 0.1° and θ_c + 0.1°, closed form
+//   billiard.csv       t, v, ω R, slip v − ω R
+//   pile.csv           step, t, then per run (warm, cold): kinetic energy, contacts, iterations,
+//                      converged, largest penetration, natural-map residual ‖F‖
+//   validation.txt     the summary lines the demo prints: measured errors against the closed forms
+//
+// Usage: ch06_validation <data directory>.
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+#include <limits>
+#include <numbers>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "grbd/body/mass_properties.hpp"
+#include "grbd/kinematics/rotation.hpp"
+#include "grbd/timestep/midpoint.hpp"
+#include "grbd/timestep/stepper.hpp"
+#include "grbd_demo/demo.hpp"
+
+namespace {
+
+using namespace grbd;
+using timestep::BodySpec;
+using timestep::BodySystem;
+using timestep::GlobalId;
+using timestep::MaterialTable;
+using timestep::MoreauStepper;
+using timestep::StaticGeometry;
+using timestep::StaticObject;
+using timestep::StepReport;
+using timestep::StepSettings;
+
+constexpr const char* kProgram = "ch06_validation";
+constexpr double kG = 9.81;
+
+/// The summary: printed and kept for validation.txt.
+std::string summary;
+
+void say(const char* format, auto... args) {
+  char line[512];
+  std::snprintf(line, sizeof line, format, args...);
+  summary += line;
+  std::cout << line << std::flush;
+}
+
+/// A dynamic sphere of radius r and density ρ at I_r with velocity u.
+BodySpec sphere(GlobalId id, double r, const Vector3& I_r, const Vector6& u = Vector6::Zero(),
+                double rho = 2500.0) {
+  const body::MassProperties mp = body::sphere_mass_properties(r, rho);
+  BodySpec spec;
+  spec.id = id;
+  spec.state.q << I_r, 1.0, 0.0, 0.0, 0.0;
+  spec.state.u = u;
+  spec.inertia = {mp.mass, mp.M_Theta_S.diagonal()};
+  spec.shape = collision::Sphere{r};
+  return spec;
+}
+
+/// The half-space nᵀx ≤ offset as static object `id`.
+StaticObject half_space(GlobalId id, const Vector3& n, double offset) {
+  StaticObject object;
+  object.id = id;
+  object.shape = collision::HalfSpace{n, offset};
+  return object;
+}
+
+/// One material whose pairs have the law (μ, ε_N, 0).
+MaterialTable one_material(double mu, double eps_N = 0.0) {
+  MaterialTable table;
+  const timestep::MaterialId m = table.add("m");
+  table.set_pair(m, m, {mu, eps_N, 0.0});
+  return table;
+}
+
+/// Solver settings for the closed-form checks: tolerances far below the effects measured.
+StepSettings tight(double dt) {
+  StepSettings s;
+  s.dt = dt;
+  s.solver.abs_tol = 1e-15;
+  s.solver.rel_tol = 1e-12;
+  s.solver.max_iterations = 100000;
+  s.on_non_convergence = timestep::NonConvergence::stop;
+  return s;
+}
+
+// ---------------------------------------------------------------------------------------------
+// The bouncing ball.
+
+struct BallRun {
+  std::vector<double> t, gap, exact, energy;
+  std::vector<double> impacts;  // start time of each step that reverses an approaching contact
+  double rest_from = -1.0;      // from this time on the ball rests (u = 0 to round-off)
+  double worst_gain = 0.0;      // largest relative increase of the energy in one step
+};
+
+/// The closed-form gap of the ball at time t: free fall to t₁, then arcs leaving impact k with
+/// ε^k √(2 g h₀), and rest after the Zeno time.
+double exact_gap(double t, double h0, double eps) {
+  const double t1 = timestep::bouncing_ball_impact_time(1, h0, kG, eps);
+  if (t < t1) return h0 - 0.5 * kG * t * t;
+  if (t >= timestep::bouncing_ball_zeno_time(h0, kG, eps)) return 0.0;
+  double t_k = t1;
+  double v_k = kG * t1;
+  for (int k = 1;; ++k) {
+    v_k *= eps;
+    const double t_next = t_k + 2.0 * v_k / kG;
+    if (t < t_next) {
+      const double s = t - t_k;
+      return v_k * s - 0.5 * kG * s * s;
+    }
+    t_k = t_next;
+    if (k > 2000) return 0.0;
+  }
+}
+
+BallRun bouncing_ball(double eps, double dt, double t_end) {
+  const double r = 0.1;
+  const double h0 = 1.0;
+  BodySystem system;
+  system.add(sphere(1, r, Vector3(0.0, 0.0, r + h0)));
+  StaticGeometry statics;
+  statics.add(half_space(0, Vector3::UnitZ(), 0.0));
+  const MaterialTable materials = one_material(0.3, eps);
+  MoreauStepper stepper(system, statics, materials, tight(dt));
+  const double m = system.inertia()[0].m;
+  const double e_rest = m * kG * r;
+  const double e0 =
+      timestep::mechanical_energy(system.inertia(), system.states(), stepper.settings().I_g) -
+      e_rest;
+  BallRun run;
+  run.t.push_back(0.0);
+  run.gap.push_back(h0);
+  run.exact.push_back(h0);
+  run.energy.push_back(1.0);
+  double energy = e0;
+  bool resting = false;
+  const double eps_mach = std::numeric_limits<double>::epsilon();
+  while (stepper.time() < t_end - 0.5 * dt) {
+    const double t = stepper.time();
+    const double v_before = system.states()[0].u.z();
+    const StepReport report = stepper.step();
+    if (report.contacts > 0 && v_before < 0.0 && stepper.percussions()[0].x() > 0.0 &&
+        system.states()[0].u.z() > 0.0) {
+      run.impacts.push_back(t);
+    }
+    const double e = report.kinetic_energy + report.potential_energy - e_rest;
+    run.worst_gain = std::max(run.worst_gain, (e - energy) / e0);
+    energy = e;
+    const Vector6& u = system.states()[0].u;
+    const bool at_rest = u.norm() <= 4.0 * eps_mach * kG * dt;
+    if (at_rest && !resting) run.rest_from = stepper.time();
+    if (!at_rest) run.rest_from = -1.0;
+    resting = at_rest;
+    run.t.push_back(stepper.time());
+    run.gap.push_back(system.states()[0].q.z() - r);
+    run.exact.push_back(exact_gap(stepper.time(), h0, eps));
+    run.energy.push_back(e / e0);
+  }
+  return run;
+}
+
+void bouncing_balls(const std::filesystem::path& dir) {
+  const double dt = 1e-3;
+  const double t_end = 4.5;
+  const double epsilons[2] = {0.8, 0.5};
+  BallRun runs[2];
+  for (int i = 0; i < 2; ++i) runs[i] = bouncing_ball(epsilons[i], dt, t_end);
+
+  demo::OutputFile out(dir / "bouncing_ball.csv",
+                       "t,gap_0.8,exact_0.8,energy_0.8,gap_0.5,exact_0.5,energy_0.5");
+  char row[256];
+  for (std::size_t k = 0; k < runs[0].t.size(); ++k) {
+    std::snprintf(row, sizeof row, "%.4f,%.6e,%.6e,%.6e,%.6e,%.6e,%.6e\n", runs[0].t[k],
+                  runs[0].gap[k], runs[0].exact[k], runs[0].energy[k], runs[1].gap[k],
+                  runs[1].exact[k], runs[1].energy[k]);
+    out << row;
+  }
+  out.finish();
+
+  constexpr int kImpacts = 8;
+  demo::OutputFile impacts(dir / "impacts.csv",
+                           "k,closed_0.8,measured_0.8,closed_0.5,measured_0.5");
+  for (int k = 1; k <= kImpacts; ++k) {
+    impacts << k;
+    for (int i = 0; i < 2; ++i) {
+      const double closed = timestep::bouncing_ball_impact_time(k, 1.0, kG, epsilons[i]);
+      impacts << ',' << closed << ',';
+      if (k <= static_cast<int>(runs[i].impacts.size())) impacts << runs[i].impacts[k - 1];
+    }
+    impacts << '\n';
+  }
+  impacts.finish();
+
+  demo::OutputFile zeno(dir / "zeno.csv", "eps,zeno,rest_from");
+  for (int i = 0; i < 2; ++i) {
+    const double eps = epsilons[i];
+    const BallRun& run = runs[i];
+    const double t_zeno = timestep::bouncing_ball_zeno_time(1.0, kG, eps);
+    zeno << eps << ',' << t_zeno << ',' << run.rest_from << '\n';
+    // Error of impact k in steps, against the bound (k + 1) Δt of the tests.
+    double worst = 0.0;
+    int worst_k = 0;
+    const int n = std::min<int>(kImpacts, static_cast<int>(run.impacts.size()));
+    for (int k = 1; k <= n; ++k) {
+      const double err =
+          std::abs(run.impacts[k - 1] - timestep::bouncing_ball_impact_time(k, 1.0, kG, eps)) / dt;
+      if (err > worst) {
+        worst = err;
+        worst_k = k;
+      }
+    }
+    say("bouncing ball, eps = %.1f: %zu impacts measured; impacts 1-%d within %.2f dt of the "
+        "closed form (worst: impact %d); Zeno time %.4f s, at rest (|u| <= 4 eps_mach g dt) from "
+        "%.4f s; largest energy gain of one step %.1e of E0\n",
+        eps, run.impacts.size(), n, worst, worst_k, t_zeno, run.rest_from,
+        std::max(run.worst_gain, 0.0));
+  }
+  zeno.finish();
+}
+
+// ---------------------------------------------------------------------------------------------
+// Block and sphere on an incline: gravity tilted by θ about y, the floor z = 0.
+
+Vector3 tilted_gravity(double theta) {
+  return kG * Vector3(std::sin(theta), 0.0, -std::cos(theta));
+}
+
+/// Steps `spec` on the floor with gravity tilted by θ until t_end; returns the velocities along
+/// the slope after each step, and the final displacement and spin.
+struct Slide {
+  std::vector<double> v;
+  double x = 0.0;
+  double omega_y = 0.0;
+};
+
+Slide slide(const BodySpec& spec, double theta, double mu, double t_end, double dt) {
+  BodySystem system;
+  system.add(spec);
+  StaticGeometry statics;
+  statics.add(half_space(0, Vector3::UnitZ(), 0.0));
+  const MaterialTable materials = one_material(mu);
+  StepSettings settings = tight(dt);
+  settings.I_g = tilted_gravity(theta);
+  MoreauStepper stepper(system, statics, materials, settings);
+  const double x0 = system.states()[0].q.x();
+  Slide s;
+  s.v.push_back(0.0);
+  while (stepper.time() < t_end - 0.5 * dt) {
+    stepper.step();
+    s.v.push_back(system.states()[0].u.x());
+  }
+  s.x = system.states()[0].q.x() - x0;
+  s.omega_y = system.states()[0].u(4);
+  return s;
+}
+
+void inclines(const std::filesystem::path& dir) {
+  const double mu = 0.5;
+  const double theta_c = std::atan(mu);
+  const double delta = 0.1 * std::numbers::pi / 180.0;
+  const double dt = 1e-3;
+  const double t_end = 1.0;
+  const Vector3 h(0.1, 0.1, 0.05);
+  BodySpec block;
+  block.id = 1;
+  const double m = 1000.0 * 8.0 * h.prod();
+  block.state.q << 0.0, 0.0, h.z(), 1.0, 0.0, 0.0, 0.0;
+  block.state.u.setZero();
+  block.inertia = {m, Vector3(m / 3.0 * (h.y() * h.y() + h.z() * h.z()),
+                              m / 3.0 * (h.x() * h.x() + h.z() * h.z()),
+                              m / 3.0 * (h.x() * h.x() + h.y() * h.y()))};
+  block.shape = collision::Box{h};
+  const Slide below = slide(block, theta_c - delta, mu, t_end, dt);
+  const double theta = theta_c + delta;
+  const double a = kG * (std::sin(theta) - mu * std::cos(theta));
+  const Slide above = slide(block, theta, mu, t_end, dt);
+
+  demo::OutputFile out(dir / "incline.csv", "t,v_below,v_above,closed_above");
+  double worst_below = 0.0;
+  double worst_above = 0.0;
+  char row[160];
+  for (std::size_t k = 0; k < above.v.size(); ++k) {
+    const double t = static_cast<double>(k) * dt;
+    worst_below = std::max(worst_below, std::abs(below.v[k]));
+    if (k > 0) worst_above = std::max(worst_above, std::abs(above.v[k] - a * t) / (a * t));
+    std::snprintf(row, sizeof row, "%.4f,%.6e,%.6e,%.6e\n", t, below.v[k], above.v[k], a * t);
+    out << row;
+  }
+  out.finish();
+  say("block on an incline, mu = %.1f, theta_c = %.4f deg: at theta_c - 0.1 deg after %.0f s "
+      "|x| = %.1e m, max |v| = %.1e m/s; at theta_c + 0.1 deg a = g(sin - mu cos) = %.5f m/s^2, "
+      "largest relative error of v = a t %.1e, of x = a t^2/2 %.1e\n",
+      mu, theta_c * 180.0 / std::numbers::pi, t_end, std::abs(below.x), worst_below, a, worst_above,
+      std::abs(above.x - 0.5 * a * t_end * t_end) / (0.5 * a * t_end * t_end));
+
+  // A sphere at 20°: rolls iff μ ≥ (2/7) tan θ.
+  const double r = 0.05;
+  const double theta_s = 20.0 * std::numbers::pi / 180.0;
+  const double mu_roll = 2.0 / 7.0 * std::tan(theta_s);
+  const BodySpec ball = sphere(1, r, Vector3(0.0, 0.0, r));
+  const Slide roll = slide(ball, theta_s, 1.05 * mu_roll, t_end, dt);
+  const double a_roll = 5.0 / 7.0 * kG * std::sin(theta_s);
+  const Slide slip = slide(ball, theta_s, 0.95 * mu_roll, t_end, dt);
+  const double a_slip = kG * (std::sin(theta_s) - 0.95 * mu_roll * std::cos(theta_s));
+  say("sphere on a 20 deg incline: mu = 1.05 (2/7) tan theta rolls, v(1 s) relative error to "
+      "(5/7) g sin theta t %.1e, |omega R - v|/v = %.1e; mu = 0.95 (2/7) tan theta slides, "
+      "relative error to g(sin - mu cos) t %.1e, omega R/v = %.3f\n",
+      std::abs(roll.v.back() - a_roll * t_end) / (a_roll * t_end),
+      std::abs(roll.omega_y * r - roll.v.back()) / roll.v.back(),
+      std::abs(slip.v.back() - a_slip * t_end) / (a_slip * t_end),
+      slip.omega_y * r / slip.v.back());
+}
+
+// ---------------------------------------------------------------------------------------------
+
+void billiard(const std::filesystem::path& dir) {
+  const double r = 0.0286;
+  const double v0 = 2.0;
+  const double mu = 0.2;
+  const double dt = 1e-4;
+  BodySystem system;
+  Vector6 u0 = Vector6::Zero();
+  u0(0) = v0;
+  system.add(sphere(1, r, Vector3(0.0, 0.0, r), u0, 1700.0));
+  StaticGeometry statics;
+  statics.add(half_space(0, Vector3::UnitZ(), 0.0));
+  const MaterialTable materials = one_material(mu);
+  MoreauStepper stepper(system, statics, materials, tight(dt));
+  const double t_star = 2.0 * v0 / (7.0 * mu * kG);
+  double t_roll = -1.0;
+  demo::OutputFile out(dir / "billiard.csv", "t,v,omega_R,slip");
+  out << "0," << v0 << ",0," << v0 << '\n';
+  char row[160];
+  int step = 0;
+  while (stepper.time() < 1.5 * t_star) {
+    stepper.step();
+    const Vector6& u = system.states()[0].u;
+    const double slip = u(0) - u(4) * r;
+    if (t_roll < 0.0 && std::abs(slip) <= 1e-9 * v0) t_roll = stepper.time();
+    if (++step % 10 == 0) {
+      std::snprintf(row, sizeof row, "%.5f,%.9e,%.9e,%.6e\n", stepper.time(), u(0), u(4) * r, slip);
+      out << row;
+    }
+  }
+  out.finish();
+  say("billiard ball, v0 = %.1f m/s, mu = %.1f, dt = %.0e s: rolling from t = %.5f s, "
+      "t* = 2 v0/(7 mu g) = %.5f s (error %.2f dt); speed %.12f m/s, (5/7) v0 = %.12f m/s "
+      "(relative error %.1e)\n",
+      v0, mu, dt, t_roll, t_star, std::abs(t_roll - t_star) / dt, system.states()[0].u(0),
+      5.0 / 7.0 * v0, std::abs(system.states()[0].u(0) - 5.0 / 7.0 * v0) / (5.0 / 7.0 * v0));
+}
+
+// ---------------------------------------------------------------------------------------------
+
+void cradle(const std::filesystem::path& dir) {
+  demo::OutputFile out(dir / "cradle.csv", "N,eps,ball,v,closed");
+  for (const int N : {3, 5}) {
+    for (const double eps : {1.0, 0.0}) {
+      BodySystem system;
+      const double r = 0.0625;  // centres 2 r i exact in binary: g_N = 0 exactly
+      for (int i = 0; i < N; ++i) {
+        Vector6 u = Vector6::Zero();
+        if (i == 0) u(0) = 1.0;
+        system.add(sphere(static_cast<GlobalId>(i + 1), r, Vector3(2.0 * r * i, 0.0, 1.0), u));
+      }
+      StaticGeometry statics;
+      const MaterialTable materials = one_material(0.0, eps);
+      StepSettings settings = tight(1e-4);
+      settings.I_g.setZero();
+      MoreauStepper stepper(system, statics, materials, settings);
+      stepper.step();
+      double worst = 0.0;
+      std::string velocities;
+      char field[64];
+      for (int i = 0; i < N; ++i) {
+        const double v = system.states()[system.index_of(static_cast<GlobalId>(i + 1))].u.x();
+        const double closed = eps == 1.0 ? (i == 0 ? (2.0 - N) / N : 2.0 / N) : 1.0 / N;
+        worst = std::max(worst, std::abs(v - closed));
+        out << N << ',' << eps << ',' << i + 1 << ',' << v << ',' << closed << '\n';
+        std::snprintf(field, sizeof field, "%s%.4f", i ? ", " : "", v);
+        velocities += field;
+      }
+      say("Newton's cradle, N = %d, eps = %.0f: v/v0 = (%s), largest error to the simultaneous "
+          "impact law %.1e\n",
+          N, eps, velocities.c_str(), worst);
+    }
+  }
+  out.finish();
+}
+
+// ---------------------------------------------------------------------------------------------
+
+void half_steps() {
+  // One body spinning at |ω| = 1 rad/s about an oblique axis, moving at 1 m/s.
+  Vector7 q;
+  q << 0.0, 0.0, 0.0,
+      kinematics::quaternion_from_axis_angle(Vector3(1.0, 2.0, 2.0).normalized(), 0.7).coeffs();
+  Vector6 u;
+  u << 1.0, 0.0, 0.0, Vector3(0.0, 0.6, 0.8);
+  double d[2];
+  const double dts[2] = {0.04, 0.02};
+  for (int i = 0; i < 2; ++i) {
+    d[i] = (timestep::half_step(q, u, dts[i]) - timestep::half_step_add_normalize(q, u, dts[i]))
+               .norm();
+  }
+  say("half step: exp map vs add-and-normalise for |omega| dt/2 = %.2f and %.2f: |dq| = %.2e "
+      "and %.2e, ratio %.2f (third order: 8)\n",
+      0.5 * dts[0], 0.5 * dts[1], d[0], d[1], d[0] / d[1]);
+}
+
+// ---------------------------------------------------------------------------------------------
+
+void painleve() {
+  const double l = 0.5;
+  const double r = 0.01;
+  const double m = 1.0;
+  const double tilt = std::numbers::pi / 4.0;
+  for (const contact::Method method : {contact::Method::apgd, contact::Method::sor}) {
+    BodySpec rod;
+    rod.id = 1;
+    rod.shape = collision::Capsule{r, l};
+    rod.inertia = {m, Vector3(m * l * l / 3.0, m * l * l / 3.0, 1e-3 * m * r * r)};
+    rod.state.q << (r + l * std::cos(tilt)) * Vector3::UnitZ(),
+        kinematics::quaternion_from_axis_angle(Vector3::UnitY(), tilt).coeffs();
+    rod.state.u << -2.0, 0.0, 0.0, 0.0, 0.0, 0.0;
+    BodySystem system;
+    system.add(rod);
+    StaticGeometry statics;
+    statics.add(half_space(0, Vector3::UnitZ(), 0.0));
+    const MaterialTable materials = one_material(1.5);
+    StepSettings settings;
+    settings.dt = 1e-4;
+    settings.method = method;
+    MoreauStepper stepper(system, statics, materials, settings);
+    int with_contact = 0;
+    double worst_gain = 0.0;
+    double energy = 0.0;
+    bool first = true;
+    while (stepper.time() < 0.3 - 0.5 * settings.dt) {
+      const StepReport report = stepper.step();
+      const double e = report.kinetic_energy + report.potential_energy;
+      if (!first) worst_gain = std::max(worst_gain, (e - energy) / std::abs(energy));
+      energy = e;
+      first = false;
+      if (report.contacts > 0) ++with_contact;
+    }
+    say("Painleve rod (mu = 1.5 > 4/3), %s: %llu steps, %d with contact, %llu stopped at "
+        "max_iterations; largest energy gain of one step %.1e; state finite: %s\n",
+        std::string(contact::method_name(method)).c_str(),
+        static_cast<unsigned long long>(stepper.steps()), with_contact,
+        static_cast<unsigned long long>(stepper.non_converged_steps()), std::max(worst_gain, 0.0),
+        system.states()[0].q.allFinite() && system.states()[0].u.allFinite() ? "yes" : "no");
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// A settling pile: spheres dropped from rest on a jittered cubic lattice into an open box.
+
+struct PileRun {
+  std::vector<StepReport> reports;
+  std::size_t spheres = 0;
+  double seconds = 0.0;
+};
+
+PileRun settle(bool warm_start, int n, double dt, double t_end, double r) {
+  const double spacing = 2.4 * r;
+  const double L = n * spacing + 0.4 * r;
+  BodySystem system;
+  std::mt19937_64 rng(6);
+  std::uniform_real_distribution<double> jitter(-0.1 * r, 0.1 * r);
+  GlobalId id = 1;
+  for (int k = 0; k < n; ++k) {
+    for (int j = 0; j < n; ++j) {
+      for (int i = 0; i < n; ++i) {
+        system.add(sphere(id++, r,
+                          Vector3(1.2 * r + spacing * i + jitter(rng),
+                                  1.2 * r + spacing * j + jitter(rng), 1.1 * r + spacing * k)));
+      }
+    }
+  }
+  StaticGeometry statics;
+  statics.add(half_space(0, Vector3::UnitZ(), 0.0));
+  statics.add(half_space(1, Vector3::UnitX(), 0.0));  // the solid x ≤ 0
+  statics.add(half_space(2, -Vector3::UnitX(), -L));  // x ≥ L
+  statics.add(half_space(3, Vector3::UnitY(), 0.0));
+  statics.add(half_space(4, -Vector3::UnitY(), -L));
+  MaterialTable materials;
+  const timestep::MaterialId glass = materials.add("glass");
+  materials.set_pair(glass, glass, {0.5, 0.0, 0.0});
+  StepSettings settings;  // the default solver: SOR, its default tolerance and 1000 iterations
+  settings.dt = dt;
+  settings.warm_start = warm_start;
+  settings.reorder_interval = 50;
+  MoreauStepper stepper(system, statics, materials, settings);
+  PileRun run;
+  run.spheres = system.size();
+  while (stepper.time() < t_end - 0.5 * dt) {
+    run.reports.push_back(stepper.step());
+    run.seconds += run.reports.back().seconds.total;
+  }
+  return run;
+}
+
+void pile(const std::filesystem::path& dir) {
+  // Glass beads of 1 mm radius at the chute's Δt = 0.2 ms (Nützi 2016), six layers.
+  const int n = 6;
+  const double r = 1e-3;
+  const double dt = 2e-4;
+  const double t_end = 0.3;
+  const PileRun warm = settle(true, n, dt, t_end, r);
+  const PileRun cold = settle(false, n, dt, t_end, r);
+  demo::OutputFile out(dir / "pile.csv",
+                       "step,t,Ek_warm,contacts_warm,iterations_warm,converged_warm,"
+                       "penetration_warm,residual_warm,Ek_cold,contacts_cold,iterations_cold,"
+                       "converged_cold,penetration_cold,residual_cold");
+  char row[400];
+  for (std::size_t k = 0; k < warm.reports.size(); ++k) {
+    const StepReport& w = warm.reports[k];
+    const StepReport& c = cold.reports[k];
+    std::snprintf(row, sizeof row, "%llu,%.5f,%.6e,%zu,%d,%d,%.6e,%.6e,%.6e,%zu,%d,%d,%.6e,%.6e\n",
+                  static_cast<unsigned long long>(w.step), w.t, w.kinetic_energy, w.contacts,
+                  w.iterations, w.converged ? 1 : 0, w.max_penetration, w.residual,
+                  c.kinetic_energy, c.contacts, c.iterations, c.converged ? 1 : 0,
+                  c.max_penetration, c.residual);
+    out << row;
+  }
+  out.finish();
+  for (const PileRun* run : {&warm, &cold}) {
+    // Iterations over the steps with contacts, and over the last quarter (the settled pile).
+    long total = 0;
+    long late = 0;
+    int late_steps = 0;
+    int non_converged = 0;
+    double penetration = 0.0;
+    double log_residual = 0.0;
+    const std::size_t steps = run->reports.size();
+    for (std::size_t k = 0; k < steps; ++k) {
+      const StepReport& report = run->reports[k];
+      total += report.iterations;
+      if (!report.converged) ++non_converged;
+      if (4 * k >= 3 * steps) {
+        late += report.iterations;
+        log_residual += std::log(std::max(report.residual, 1e-300));
+        ++late_steps;
+      }
+      penetration = std::max(penetration, report.max_penetration);
+    }
+    const StepReport& last = run->reports.back();
+    say("pile of %zu spheres (r = %.0e m, mu = 0.5), %s start, dt = %.0e s, %.1f s: %zu contacts "
+        "at the end, E_kin %.1e J; iterations per step %.1f on average, %.1f over the last "
+        "quarter (geometric mean of the residual ||F|| there %.1e); %d of %zu steps at "
+        "max_iterations; "
+        "largest penetration %.2e m (%.1e r); %.1f s of CPU\n",
+        run->spheres, r, run == &warm ? "warm" : "cold", dt, t_end, last.contacts,
+        last.kinetic_energy, double(total) / double(steps), double(late) / late_steps,
+        std::exp(log_residual / late_steps), non_converged, steps, penetration, penetration / r,
+        run->seconds);
+  }
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  if (const auto exit_code = grbd::demo::check_arguments(
+          argc, argv, kProgram, {"<data directory>"},
+          "writes bouncing_ball.csv, impacts.csv, zeno.csv, incline.csv, billiard.csv, "
+          "cradle.csv, pile.csv and validation.txt")) {
+    return *exit_code;
+  }
+  try {
+    const std::filesystem::path dir = argv[1];
+    bouncing_balls(dir);
+    inclines(dir);
+    billiard(dir);
+    cradle(dir);
+    half_steps();
+    painleve();
+    pile(dir);
+    grbd::demo::OutputFile table(dir / "validation.txt");
+    table << summary;
+    table.finish();
+    return 0;
+  } catch (...) {
+    return grbd::demo::report_exception(kProgram, "Exercises 6.1-6.6");
+  }
+}
