@@ -98,26 +98,46 @@ std::pair<Vector3, Vector3> grid_box(std::string_view where, std::span<const Vec
 
 }  // namespace
 
-std::vector<std::int32_t> morton_order(std::span<const Vector3> centres, double cell_size) {
-  require_positive_finite("morton_order", "cell size", cell_size);
-  require_finite_centres("morton_order", centres);
-  const auto n = static_cast<std::int32_t>(centres.size());
-  std::vector<std::int32_t> order(centres.size());
-  if (n == 0) return order;
-  const auto [lo, hi] = grid_box("morton_order", centres);
+namespace {
+
+// morton_codes() with the caller's name in its messages.
+void checked_morton_codes(std::string_view where, std::span<const Vector3> points,
+                          double cell_size, std::span<std::uint64_t> codes) {
+  require_positive_finite(where, "cell size", cell_size);
+  if (codes.size() != points.size()) {
+    throw InvalidArgument(std::string(where) + ": expected one code per point, found room for " +
+                          std::to_string(codes.size()) + " codes and " +
+                          std::to_string(points.size()) + " points");
+  }
+  require_finite_centres(where, points);
+  if (points.empty()) return;
+  const auto [lo, hi] = grid_box(where, points);
   // Coarsen the cells where the box would need more than 2²¹ of them along an axis.
   const double h = std::max(cell_size, (hi - lo).maxCoeff() / double(kMaxCellsPerAxis - 1));
-  const auto max_cell = static_cast<std::int32_t>(kMaxCellsPerAxis - 1);
-  std::vector<std::pair<std::uint64_t, std::int32_t>> keys(centres.size());
-  for (std::int32_t i = 0; i < n; ++i) {
-    const Vector3 t = (centres[i] - lo) / h;
-    keys[i] = {morton_code(static_cast<std::uint32_t>(cell_coordinate(t.x(), max_cell + 1)),
-                           static_cast<std::uint32_t>(cell_coordinate(t.y(), max_cell + 1)),
-                           static_cast<std::uint32_t>(cell_coordinate(t.z(), max_cell + 1))),
-               i};
+  const auto cells = static_cast<std::int32_t>(kMaxCellsPerAxis);
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    const Vector3 t = (points[i] - lo) / h;
+    codes[i] = morton_code(static_cast<std::uint32_t>(cell_coordinate(t.x(), cells)),
+                           static_cast<std::uint32_t>(cell_coordinate(t.y(), cells)),
+                           static_cast<std::uint32_t>(cell_coordinate(t.z(), cells)));
   }
+}
+
+}  // namespace
+
+void morton_codes(std::span<const Vector3> points, double cell_size,
+                  std::span<std::uint64_t> codes) {
+  checked_morton_codes("morton_codes", points, cell_size, codes);
+}
+
+std::vector<std::int32_t> morton_order(std::span<const Vector3> centres, double cell_size) {
+  std::vector<std::uint64_t> codes(centres.size());
+  checked_morton_codes("morton_order", centres, cell_size, codes);
+  std::vector<std::pair<std::uint64_t, std::int32_t>> keys(centres.size());
+  for (std::size_t i = 0; i < keys.size(); ++i) keys[i] = {codes[i], static_cast<std::int32_t>(i)};
   std::sort(keys.begin(), keys.end());  // by code, then by index
-  for (std::int32_t m = 0; m < n; ++m) order[m] = keys[m].second;
+  std::vector<std::int32_t> order(centres.size());
+  for (std::size_t m = 0; m < order.size(); ++m) order[m] = keys[m].second;
   return order;
 }
 

@@ -193,28 +193,14 @@ void BodySystem::permute(std::span<const std::int32_t> order) {
 
 // [reorder morton]
 void BodySystem::reorder_morton(double cell_size) {
-  require_positive_finite("BodySystem::reorder_morton", "cell size", cell_size);
   const std::size_t n = size();
+  positions_.resize(n);
+  for (std::size_t i = 0; i < n; ++i) positions_[i] = states_[i].q.head<3>();
+  codes_.resize(n);
+  collision::morton_codes(positions_, cell_size, codes_);
   if (n == 0) return;
-  Vector3 lo = states_[0].q.head<3>();
-  Vector3 hi = lo;
-  for (const body::State& s : states_) {
-    lo = lo.cwiseMin(s.q.head<3>());
-    hi = hi.cwiseMax(s.q.head<3>());
-  }
-  // 2²¹ cells per axis at most: coarser cells where the box is larger.
-  constexpr double kCells = double(1 << 21) - 1.0;
-  const double h = std::max(cell_size, (hi - lo).maxCoeff() / kCells);
-  const auto cell = [&](double x, double low) {
-    return static_cast<std::uint32_t>(std::clamp(std::floor((x - low) / h), 0.0, kCells));
-  };
   morton_keys_.resize(n);
-  for (std::size_t i = 0; i < n; ++i) {
-    const Vector3 r = states_[i].q.head<3>();
-    morton_keys_[i] = {collision::morton_code(cell(r.x(), lo.x()), cell(r.y(), lo.y()),
-                                              cell(r.z(), lo.z())),
-                       ids_[i]};
-  }
+  for (std::size_t i = 0; i < n; ++i) morton_keys_[i] = {codes_[i], ids_[i]};
   // Sorting (code, id) pairs and looking the ids up keeps the order independent of the current
   // one: two systems with the same bodies get the same layout.
   std::sort(morton_keys_.begin(), morton_keys_.end());

@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <bit>
 #include <cmath>
+#include <limits>
 #include <string>
 
 #include "grbd/collision/narrow_phase.hpp"
@@ -164,36 +165,21 @@ void ContactDetector::detect(const BodySystem& system, const StaticGeometry& sta
   }
 
   // The canonical order: along the Morton curve of the contact points (the midpoint of the two
-  // closest points), on 2²¹ cells per axis of their bounding box, ties broken by key.
+  // closest points), on the finest grid of their bounding box, 2²¹ cells along its longest axis,
+  // ties broken by key.
   const std::size_t m = unsorted_.size();
-  order_.resize(m);
-  if (m > 0) {
-    const auto mid = [&](std::size_t k) {
-      return Vector3(0.5 * (unsorted_[k].geometry.I_r_a + unsorted_[k].geometry.I_r_b));
-    };
-    Vector3 lo = mid(0);
-    Vector3 hi = lo;
-    for (std::size_t k = 1; k < m; ++k) {
-      lo = lo.cwiseMin(mid(k));
-      hi = hi.cwiseMax(mid(k));
-    }
-    constexpr double kCells = double(1 << 21) - 1.0;
-    const double extent = (hi - lo).maxCoeff();
-    const double scale = extent > 0.0 && std::isfinite(extent) ? kCells / extent : 0.0;
-    const auto cell = [&](double x, double low) {
-      return static_cast<std::uint32_t>(std::clamp(std::floor((x - low) * scale), 0.0, kCells));
-    };
-    for (std::size_t k = 0; k < m; ++k) {
-      const Vector3 p = mid(k);
-      order_[k] = {collision::morton_code(cell(p.x(), lo.x()), cell(p.y(), lo.y()),
-                                          cell(p.z(), lo.z())),
-                   static_cast<std::uint32_t>(k)};
-    }
-    std::sort(order_.begin(), order_.end(), [&](const auto& x, const auto& y) {
-      if (x.first != y.first) return x.first < y.first;
-      return unsorted_keys_[x.second] < unsorted_keys_[y.second];
-    });
+  midpoints_.resize(m);
+  for (std::size_t k = 0; k < m; ++k) {
+    midpoints_[k] = 0.5 * (unsorted_[k].geometry.I_r_a + unsorted_[k].geometry.I_r_b);
   }
+  codes_.resize(m);
+  collision::morton_codes(midpoints_, std::numeric_limits<double>::min(), codes_);
+  order_.resize(m);
+  for (std::size_t k = 0; k < m; ++k) order_[k] = {codes_[k], static_cast<std::uint32_t>(k)};
+  std::sort(order_.begin(), order_.end(), [&](const auto& x, const auto& y) {
+    if (x.first != y.first) return x.first < y.first;
+    return unsorted_keys_[x.second] < unsorted_keys_[y.second];
+  });
   contacts.resize(m);
   keys.resize(m);
   for (std::size_t k = 0; k < m; ++k) {

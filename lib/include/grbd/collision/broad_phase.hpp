@@ -24,6 +24,14 @@ using IndexPair = std::pair<std::int32_t, std::int32_t>;
 std::uint64_t morton_code(std::uint32_t i, std::uint32_t j, std::uint32_t k);
 // [morton declaration]
 
+/// The Morton code of each point's cell, the cells of edge `cell_size` counted from the points'
+/// bounding box (where the box would need more than 2²¹ cells per axis the cells grow to fit):
+/// codes[i] for points[i]. Allocates nothing. Needs a finite cell_size > 0, finite points whose
+/// differences are finite, and codes.size() == points.size(), else grbd::InvalidArgument. The
+/// smallest positive cell size gives the finest grid, 2²¹ cells along the longest axis.
+void morton_codes(std::span<const Vector3> points, double cell_size,
+                  std::span<std::uint64_t> codes);
+
 /// The permutation that sorts the points by the Morton code of their cell of size `cell_size`
 /// (relative to the points' bounding box): order[n] is the index of the n-th point in Z-order,
 /// ties broken by index. Where the box would need more than 2²¹ cells per axis the cells grow to

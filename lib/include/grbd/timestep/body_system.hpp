@@ -70,7 +70,8 @@ class BodySystem {
   void permute(std::span<const std::int32_t> order);
   /// Reorders the bodies along the Morton (Z-order) curve of their centres on cells of edge
   /// `cell_size`, ties broken by global id: the same positions give the same order whatever the
-  /// current order. O(N log N); allocates nothing once it has run at this size.
+  /// current order (collision::morton_codes(), whose InvalidArgument it passes on). O(N log N);
+  /// allocates nothing once it has run at this size.
   void reorder_morton(double cell_size);
 
   /// Number of bodies.
@@ -120,6 +121,8 @@ class BodySystem {
   std::vector<std::uint32_t> slots_;
   // Scratch of permute() and reorder_morton(), kept to avoid allocation.
   std::vector<std::uint8_t> done_;
+  std::vector<Vector3> positions_;
+  std::vector<std::uint64_t> codes_;
   std::vector<std::pair<std::uint64_t, GlobalId>> morton_keys_;
   std::vector<std::int32_t> order_;
   std::vector<std::int32_t> position_;

@@ -59,6 +59,8 @@ class ContactDetector {
   std::vector<collision::ContactGeometry> found_;
   std::vector<collision::Contact> unsorted_;
   std::vector<ContactKey> unsorted_keys_;
+  std::vector<Vector3> midpoints_;
+  std::vector<std::uint64_t> codes_;
   std::vector<std::pair<std::uint64_t, std::uint32_t>> order_;
 };
 
