@@ -14,6 +14,7 @@
 #include "grbd/body/mass_properties.hpp"
 #include "grbd/timestep/body_system.hpp"
 #include "grbd/timestep/materials.hpp"
+#include "scenes.hpp"
 
 namespace grbd::demo {
 
@@ -44,17 +45,11 @@ inline void fcc_pile(timestep::BodySystem& system, timestep::StaticGeometry& sta
   }
   system.reorder_morton(2.0 * r);
   // The ground and four walls touching the outermost spheres: x, y ∈ [−r, a (n − ½) + r].
-  const auto half_space = [&](timestep::GlobalId id, const Vector3& n, double offset) {
-    timestep::StaticObject object;
-    object.id = id;
-    object.shape = collision::HalfSpace{n, offset};  // the solid nᵀx ≤ offset
-    statics.add(object);
-  };
-  half_space(0, Vector3::UnitZ(), 0.0);
-  half_space(1, Vector3::UnitX(), -r);
-  half_space(2, -Vector3::UnitX(), -(a * (nx - 0.5) + r));
-  half_space(3, Vector3::UnitY(), -r);
-  half_space(4, -Vector3::UnitY(), -(a * (ny - 0.5) + r));
+  statics.add(half_space(0, Vector3::UnitZ(), 0.0));
+  statics.add(half_space(1, Vector3::UnitX(), -r));
+  statics.add(half_space(2, -Vector3::UnitX(), -(a * (nx - 0.5) + r)));
+  statics.add(half_space(3, Vector3::UnitY(), -r));
+  statics.add(half_space(4, -Vector3::UnitY(), -(a * (ny - 0.5) + r)));
 }
 
 /// One material, glass on glass and on the ground: μ = 0.5, no restitution.

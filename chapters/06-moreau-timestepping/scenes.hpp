@@ -1,18 +1,22 @@
 #pragma once
-/// \file
-/// \brief Small scenes for the chapter-6 tests: spheres, boxes and capsules of uniform density as
-/// BodySpecs, a floor, and a settled-pile generator.
+// Chapter 6: the scenes of the validation cases, shared by the demo ch06_validation and the tests
+// (tests/06-moreau-timestepping): spheres and boxes of uniform density as BodySpecs, the floor and
+// other half-spaces, one-material tables, the tight solver settings of the closed-form checks,
+// tilted gravity for the incline, the Painlevé rod, and a jittered lattice of spheres in an open
+// box.
 
 #include <cmath>
+#include <numbers>
 #include <cstdint>
 #include <random>
 
 #include "grbd/body/mass_properties.hpp"
+#include "grbd/kinematics/rotation.hpp"
 #include "grbd/timestep/body_system.hpp"
 #include "grbd/timestep/materials.hpp"
 #include "grbd/timestep/stepper.hpp"
 
-namespace grbd::test {
+namespace grbd::demo {
 
 /// A dynamic sphere of radius r and density ρ at I_r with velocity u.
 inline timestep::BodySpec sphere_body(timestep::GlobalId id, double r, const Vector3& I_r,
@@ -44,14 +48,20 @@ inline timestep::BodySpec box_body(timestep::GlobalId id, const Vector3& h, cons
   return spec;
 }
 
+/// The half-space nᵀx ≤ offset (outward normal n) as static object `id`.
+inline timestep::StaticObject half_space(timestep::GlobalId id, const Vector3& n, double offset,
+                                         timestep::MaterialId material = 0) {
+  timestep::StaticObject object;
+  object.id = id;
+  object.shape = collision::HalfSpace{n, offset};
+  object.material = material;
+  return object;
+}
+
 /// The floor z = 0 as static object `id`.
 inline timestep::StaticObject floor_object(timestep::GlobalId id = 0,
                                            timestep::MaterialId material = 0) {
-  timestep::StaticObject floor;
-  floor.id = id;
-  floor.shape = collision::HalfSpace{Vector3::UnitZ(), 0.0};
-  floor.material = material;
-  return floor;
+  return half_space(id, Vector3::UnitZ(), 0.0, material);
 }
 
 /// One material "m" whose pairs with itself have the law (μ, ε_N, ε_T).
@@ -60,6 +70,42 @@ inline timestep::MaterialTable one_material(double mu, double eps_N = 0.0, doubl
   const timestep::MaterialId m = table.add("m");
   table.set_pair(m, m, {mu, eps_N, eps_T});
   return table;
+}
+
+/// Solver settings for the closed-form checks: tolerances far below the effects measured, and a
+/// step that does not converge stops the run.
+inline timestep::StepSettings tight(double dt) {
+  timestep::StepSettings s;
+  s.dt = dt;
+  s.solver.abs_tol = 1e-15;
+  s.solver.rel_tol = 1e-12;
+  s.solver.max_iterations = 100000;
+  s.on_non_convergence = timestep::NonConvergence::stop;
+  return s;
+}
+
+/// Gravity g = 9.81 m/s² tilted by θ about y: the floor z = 0 becomes an incline of angle θ,
+/// downhill along +x.
+inline Vector3 tilted_gravity(double theta) {
+  return 9.81 * Vector3(std::sin(theta), 0.0, -std::cos(theta));
+}
+
+/// A uniform rod (a capsule of radius 1 cm and half length 0.5 m, 1 kg) leaning forward at 45°
+/// with its lower end touching the floor, sliding at 2 m/s: with μ = 1.5 > 4/3 it is in the
+/// Painlevé window of a rod (k = m l²/I = 3: μ > 2√(1 + k)/k; Stewart 2000).
+inline timestep::BodySpec painleve_rod() {
+  const double l = 0.5;
+  const double r = 0.01;
+  const double m = 1.0;
+  const double tilt = std::numbers::pi / 4.0;
+  timestep::BodySpec rod;
+  rod.id = 1;
+  rod.shape = collision::Capsule{r, l};
+  rod.inertia = {m, Vector3(m * l * l / 3.0, m * l * l / 3.0, 1e-3 * m * r * r)};
+  rod.state.q << (r + l * std::cos(tilt)) * Vector3::UnitZ(),
+      kinematics::quaternion_from_axis_angle(Vector3::UnitY(), tilt).coeffs();
+  rod.state.u << -2.0, 0.0, 0.0, 0.0, 0.0, 0.0;
+  return rod;
 }
 
 /// Spheres of radius r on a jittered cubic lattice of nx × ny × nz sites above the floor, inside
@@ -84,18 +130,12 @@ inline void add_sphere_lattice(timestep::BodySystem& system, int nx, int ny, int
 
 /// The floor and four walls of a box [0, Lx] × [0, Ly] open at the top, static ids 0–4.
 inline void add_open_box(timestep::StaticGeometry& statics, double Lx, double Ly) {
+  // The solid of each wall is { x : nᵀx ≤ offset }: its outward normal points into the box.
   statics.add(floor_object(0));
-  const auto wall = [&](timestep::GlobalId id, const Vector3& n, double offset) {
-    timestep::StaticObject w;
-    w.id = id;
-    // The solid is { x : nᵀx ≤ offset }: the wall's outward normal points into the box.
-    w.shape = collision::HalfSpace{n, offset};
-    statics.add(w);
-  };
-  wall(1, Vector3::UnitX(), 0.0);
-  wall(2, -Vector3::UnitX(), -Lx);
-  wall(3, Vector3::UnitY(), 0.0);
-  wall(4, -Vector3::UnitY(), -Ly);
+  statics.add(half_space(1, Vector3::UnitX(), 0.0));
+  statics.add(half_space(2, -Vector3::UnitX(), -Lx));
+  statics.add(half_space(3, Vector3::UnitY(), 0.0));
+  statics.add(half_space(4, -Vector3::UnitY(), -Ly));
 }
 
-}  // namespace grbd::test
+}  // namespace grbd::demo

@@ -44,11 +44,11 @@
 #include <string>
 #include <vector>
 
-#include "grbd/body/mass_properties.hpp"
 #include "grbd/kinematics/rotation.hpp"
 #include "grbd/timestep/midpoint.hpp"
 #include "grbd/timestep/stepper.hpp"
 #include "grbd_demo/demo.hpp"
+#include "scenes.hpp"
 
 namespace {
 
@@ -59,7 +59,6 @@ using timestep::GlobalId;
 using timestep::MaterialTable;
 using timestep::MoreauStepper;
 using timestep::StaticGeometry;
-using timestep::StaticObject;
 using timestep::StepReport;
 using timestep::StepSettings;
 
@@ -76,45 +75,10 @@ void say(const char* format, auto... args) {
   std::cout << line << std::flush;
 }
 
-/// A dynamic sphere of radius r and density ρ at I_r with velocity u.
-BodySpec sphere(GlobalId id, double r, const Vector3& I_r, const Vector6& u = Vector6::Zero(),
-                double rho = 2500.0) {
-  const body::MassProperties mp = body::sphere_mass_properties(r, rho);
-  BodySpec spec;
-  spec.id = id;
-  spec.state.q << I_r, 1.0, 0.0, 0.0, 0.0;
-  spec.state.u = u;
-  spec.inertia = {mp.mass, mp.M_Theta_S.diagonal()};
-  spec.shape = collision::Sphere{r};
-  return spec;
-}
-
-/// The half-space nᵀx ≤ offset as static object `id`.
-StaticObject half_space(GlobalId id, const Vector3& n, double offset) {
-  StaticObject object;
-  object.id = id;
-  object.shape = collision::HalfSpace{n, offset};
-  return object;
-}
-
-/// One material whose pairs have the law (μ, ε_N, 0).
-MaterialTable one_material(double mu, double eps_N = 0.0) {
-  MaterialTable table;
-  const timestep::MaterialId m = table.add("m");
-  table.set_pair(m, m, {mu, eps_N, 0.0});
-  return table;
-}
-
-/// Solver settings for the closed-form checks: tolerances far below the effects measured.
-StepSettings tight(double dt) {
-  StepSettings s;
-  s.dt = dt;
-  s.solver.abs_tol = 1e-15;
-  s.solver.rel_tol = 1e-12;
-  s.solver.max_iterations = 100000;
-  s.on_non_convergence = timestep::NonConvergence::stop;
-  return s;
-}
+using demo::half_space;
+using demo::one_material;
+using demo::tight;
+using demo::tilted_gravity;
 
 // ---------------------------------------------------------------------------------------------
 // The bouncing ball.
@@ -150,7 +114,7 @@ BallRun bouncing_ball(double eps, double dt, double t_end) {
   const double r = 0.1;
   const double h0 = 1.0;
   BodySystem system;
-  system.add(sphere(1, r, Vector3(0.0, 0.0, r + h0)));
+  system.add(demo::sphere_body(1, r, Vector3(0.0, 0.0, r + h0)));
   StaticGeometry statics;
   statics.add(half_space(0, Vector3::UnitZ(), 0.0));
   const MaterialTable materials = one_material(0.3, eps);
@@ -254,10 +218,6 @@ void bouncing_balls(const std::filesystem::path& dir) {
 // ---------------------------------------------------------------------------------------------
 // Block and sphere on an incline: gravity tilted by θ about y, the floor z = 0.
 
-Vector3 tilted_gravity(double theta) {
-  return kG * Vector3(std::sin(theta), 0.0, -std::cos(theta));
-}
-
 /// Steps `spec` on the floor with gravity tilted by θ until t_end; returns the velocities along
 /// the slope after each step, and the final displacement and spin.
 struct Slide {
@@ -294,15 +254,7 @@ void inclines(const std::filesystem::path& dir) {
   const double dt = 1e-3;
   const double t_end = 1.0;
   const Vector3 h(0.1, 0.1, 0.05);
-  BodySpec block;
-  block.id = 1;
-  const double m = 1000.0 * 8.0 * h.prod();
-  block.state.q << 0.0, 0.0, h.z(), 1.0, 0.0, 0.0, 0.0;
-  block.state.u.setZero();
-  block.inertia = {m, Vector3(m / 3.0 * (h.y() * h.y() + h.z() * h.z()),
-                              m / 3.0 * (h.x() * h.x() + h.z() * h.z()),
-                              m / 3.0 * (h.x() * h.x() + h.y() * h.y()))};
-  block.shape = collision::Box{h};
+  const BodySpec block = demo::box_body(1, h, Vector3(0.0, 0.0, h.z()));
   const Slide below = slide(block, theta_c - delta, mu, t_end, dt);
   const double theta = theta_c + delta;
   const double a = kG * (std::sin(theta) - mu * std::cos(theta));
@@ -330,7 +282,7 @@ void inclines(const std::filesystem::path& dir) {
   const double r = 0.05;
   const double theta_s = 20.0 * std::numbers::pi / 180.0;
   const double mu_roll = 2.0 / 7.0 * std::tan(theta_s);
-  const BodySpec ball = sphere(1, r, Vector3(0.0, 0.0, r));
+  const BodySpec ball = demo::sphere_body(1, r, Vector3(0.0, 0.0, r));
   const Slide roll = slide(ball, theta_s, 1.05 * mu_roll, t_end, dt);
   const double a_roll = 5.0 / 7.0 * kG * std::sin(theta_s);
   const Slide slip = slide(ball, theta_s, 0.95 * mu_roll, t_end, dt);
@@ -354,7 +306,7 @@ void billiard(const std::filesystem::path& dir) {
   BodySystem system;
   Vector6 u0 = Vector6::Zero();
   u0(0) = v0;
-  system.add(sphere(1, r, Vector3(0.0, 0.0, r), u0, 1700.0));
+  system.add(demo::sphere_body(1, r, Vector3(0.0, 0.0, r), u0, 1700.0));
   StaticGeometry statics;
   statics.add(half_space(0, Vector3::UnitZ(), 0.0));
   const MaterialTable materials = one_material(mu);
@@ -394,7 +346,8 @@ void cradle(const std::filesystem::path& dir) {
       for (int i = 0; i < N; ++i) {
         Vector6 u = Vector6::Zero();
         if (i == 0) u(0) = 1.0;
-        system.add(sphere(static_cast<GlobalId>(i + 1), r, Vector3(2.0 * r * i, 0.0, 1.0), u));
+        system.add(demo::sphere_body(static_cast<GlobalId>(i + 1), r,
+                                     Vector3(2.0 * r * i, 0.0, 1.0), u));
       }
       StaticGeometry statics;
       const MaterialTable materials = one_material(0.0, eps);
@@ -444,18 +397,8 @@ void half_steps() {
 // ---------------------------------------------------------------------------------------------
 
 void painleve() {
-  const double l = 0.5;
-  const double r = 0.01;
-  const double m = 1.0;
-  const double tilt = std::numbers::pi / 4.0;
   for (const contact::Method method : {contact::Method::apgd, contact::Method::sor}) {
-    BodySpec rod;
-    rod.id = 1;
-    rod.shape = collision::Capsule{r, l};
-    rod.inertia = {m, Vector3(m * l * l / 3.0, m * l * l / 3.0, 1e-3 * m * r * r)};
-    rod.state.q << (r + l * std::cos(tilt)) * Vector3::UnitZ(),
-        kinematics::quaternion_from_axis_angle(Vector3::UnitY(), tilt).coeffs();
-    rod.state.u << -2.0, 0.0, 0.0, 0.0, 0.0, 0.0;
+    const BodySpec rod = demo::painleve_rod();
     BodySystem system;
     system.add(rod);
     StaticGeometry statics;
@@ -505,7 +448,7 @@ PileRun settle(bool warm_start, int n, double dt, double t_end, double r) {
   for (int k = 0; k < n; ++k) {
     for (int j = 0; j < n; ++j) {
       for (int i = 0; i < n; ++i) {
-        system.add(sphere(id++, r,
+        system.add(demo::sphere_body(id++, r,
                           Vector3(1.2 * r + spacing * i + jitter(rng),
                                   1.2 * r + spacing * j + jitter(rng), 1.1 * r + spacing * k)));
       }

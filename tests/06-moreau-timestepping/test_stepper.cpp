@@ -15,7 +15,6 @@
 #include <vector>
 
 #include "grbd/core/error.hpp"
-#include "grbd/kinematics/rotation.hpp"
 #include "grbd/timestep/midpoint.hpp"
 #include "grbd/timestep/stepper.hpp"
 #include "scenes.hpp"
@@ -23,21 +22,13 @@
 namespace grbd::timestep {
 namespace {
 
-using test::sphere_body;
+using demo::sphere_body;
 
 constexpr double kG = 9.81;
 constexpr double kEps = std::numeric_limits<double>::epsilon();
 
-/// Tight solver settings for the closed-form checks.
-StepSettings tight(double dt) {
-  StepSettings s;
-  s.dt = dt;
-  s.solver.abs_tol = 1e-15;
-  s.solver.rel_tol = 1e-12;
-  s.solver.max_iterations = 100000;
-  s.on_non_convergence = NonConvergence::stop;
-  return s;
-}
+using demo::tight;
+using demo::tilted_gravity;
 
 // ---------------------------------------------------------------------------------------------
 // The bouncing ball: impacts at t_k = t₁ (1 + 2ε + … + 2ε^(k−1)), rest after the Zeno time.
@@ -55,8 +46,8 @@ Bounce bounce(double eps, double dt, double t_end) {
   const double h0 = 1.0;
   system.add(sphere_body(1, r, Vector3(0.0, 0.0, r + h0)));
   StaticGeometry statics;
-  statics.add(test::floor_object());
-  const MaterialTable materials = test::one_material(0.3, eps);
+  statics.add(demo::floor_object());
+  const MaterialTable materials = demo::one_material(0.3, eps);
   MoreauStepper stepper(system, statics, materials, tight(dt));
   Bounce result;
   double energy = mechanical_energy(system.inertia(), system.states(), stepper.settings().I_g);
@@ -121,10 +112,6 @@ TEST(BouncingBall, MechanicalEnergyNeverIncreases) {
 // ---------------------------------------------------------------------------------------------
 // Block and sphere on an incline: gravity tilted by θ about y, the floor z = 0.
 
-Vector3 tilted_gravity(double theta) {
-  return kG * Vector3(std::sin(theta), 0.0, -std::cos(theta));
-}
-
 struct Slide {
   double x = 0.0;  // displacement along the slope after t_end
   double v = 0.0;  // velocity along the slope
@@ -135,8 +122,8 @@ Slide incline(const BodySpec& spec, double theta, double mu, double t_end, doubl
   BodySystem system;
   system.add(spec);
   StaticGeometry statics;
-  statics.add(test::floor_object());
-  const MaterialTable materials = test::one_material(mu);
+  statics.add(demo::floor_object());
+  const MaterialTable materials = demo::one_material(mu);
   StepSettings settings = tight(dt);
   settings.I_g = tilted_gravity(theta);
   MoreauStepper stepper(system, statics, materials, settings);
@@ -150,7 +137,7 @@ TEST(Incline, ABlockSticksJustBelowTheFrictionAngleAndSlidesJustAbove) {
   const double theta_c = std::atan(mu);
   const double delta = 0.1 * std::numbers::pi / 180.0;
   const Vector3 h(0.1, 0.1, 0.05);
-  const BodySpec block = test::box_body(1, h, Vector3(0.0, 0.0, h.z()));
+  const BodySpec block = demo::box_body(1, h, Vector3(0.0, 0.0, h.z()));
   const double t = 1.0;
   const Slide stick = incline(block, theta_c - delta, mu, t);
   EXPECT_LE(std::abs(stick.x), 1e-12) << "creep below the friction angle";
@@ -193,8 +180,8 @@ TEST(BilliardBall, RollingStartsAtTwoV0Over7MuGWithFiveSeventhsOfTheSpeed) {
   u0(0) = v0;
   system.add(sphere_body(1, r, Vector3(0.0, 0.0, r), u0, 1700.0));
   StaticGeometry statics;
-  statics.add(test::floor_object());
-  const MaterialTable materials = test::one_material(mu);
+  statics.add(demo::floor_object());
+  const MaterialTable materials = demo::one_material(mu);
   MoreauStepper stepper(system, statics, materials, tight(dt));
   const double t_star = 2.0 * v0 / (7.0 * mu * kG);
   double t_roll = -1.0;
@@ -223,7 +210,7 @@ std::vector<double> cradle(int N, double eps) {
     system.add(sphere_body(static_cast<GlobalId>(i + 1), r, Vector3(2.0 * r * i, 0.0, 1.0), u));
   }
   StaticGeometry statics;
-  const MaterialTable materials = test::one_material(0.0, eps);
+  const MaterialTable materials = demo::one_material(0.0, eps);
   StepSettings settings = tight(1e-4);
   settings.I_g.setZero();
   MoreauStepper stepper(system, statics, materials, settings);
@@ -259,8 +246,8 @@ TEST(SphereColumn, PercussionKMgDtAtTheKthContactFromTheTopAndNoDrift) {
     system.add(sphere_body(static_cast<GlobalId>(i + 1), r, Vector3(0.0, 0.0, r + 2.0 * r * i)));
   }
   StaticGeometry statics;
-  statics.add(test::floor_object());
-  const MaterialTable materials = test::one_material(0.5);
+  statics.add(demo::floor_object());
+  const MaterialTable materials = demo::one_material(0.5);
   MoreauStepper stepper(system, statics, materials, tight(dt));
   const double m = system.inertia()[0].m;
   std::vector<Vector7> q0;
@@ -300,7 +287,7 @@ double pyramid_sag(double mu_spheres, double mu_floor) {
   system.add(
       sphere_body(3, r, Vector3(0.0, 0.0, r + std::sqrt(3.0) * r), Vector6::Zero(), 2500.0, ball));
   StaticGeometry statics;
-  statics.add(test::floor_object(0, ground));
+  statics.add(demo::floor_object(0, ground));
   MoreauStepper stepper(system, statics, materials, tight(1e-3));
   const double z0 = system.states()[2].q.z();
   while (stepper.time() < 0.5) stepper.step();
@@ -324,27 +311,15 @@ struct RodRun {
   bool finite = true;
 };
 
-RodRun painleve_rod(contact::Method method) {
-  // A uniform rod (a capsule of half length l) leaning at 45° and sliding with μ = 1.5 > 4/3, the
-  // Painlevé window of a rod (k = m l²/I = 3: μ > 2√(1 + k)/k), where the acceleration-level
+RodRun slide_painleve_rod(contact::Method method) {
+  // The rod of demo::painleve_rod() in the Painlevé window, where the acceleration-level
   // problem may have no solution or two (Stewart 2000); the velocity-level step always has one.
-  const double l = 0.5;
-  const double r = 0.01;
-  const double m = 1.0;
-  const double tilt = std::numbers::pi / 4.0;
-  BodySpec rod;
-  rod.id = 1;
-  rod.shape = collision::Capsule{r, l};
-  rod.inertia = {m, Vector3(m * l * l / 3.0, m * l * l / 3.0, 1e-3 * m * r * r)};
-  // The lower end just touches the floor.
-  rod.state.q << (r + l * std::cos(tilt)) * Vector3::UnitZ(),
-      kinematics::quaternion_from_axis_angle(Vector3::UnitY(), tilt).coeffs();
-  rod.state.u << -2.0, 0.0, 0.0, 0.0, 0.0, 0.0;
+  const BodySpec rod = demo::painleve_rod();
   BodySystem system;
   system.add(rod);
   StaticGeometry statics;
-  statics.add(test::floor_object());
-  const MaterialTable materials = test::one_material(1.5);
+  statics.add(demo::floor_object());
+  const MaterialTable materials = demo::one_material(1.5);
   StepSettings settings;
   settings.dt = 1e-4;
   settings.method = method;
@@ -368,14 +343,14 @@ RodRun painleve_rod(contact::Method method) {
 
 TEST(Painleve, ARodSlidingOnARoughFloorKeepsGoing) {
   // APGD solves every step of the slide to its tolerance; the energy never grows beyond it.
-  const RodRun apgd = painleve_rod(contact::Method::apgd);
+  const RodRun apgd = slide_painleve_rod(contact::Method::apgd);
   EXPECT_TRUE(apgd.finite);
   EXPECT_GT(apgd.steps_with_contact, 100);
   EXPECT_EQ(apgd.non_converged, 0u);
   EXPECT_LT(apgd.worst_gain, 1e-7);
   // SOR's fixed point of this single, strongly coupled contact cycles in many steps: the stepper
   // counts them and goes on (NonConvergence::count), with a finite state throughout.
-  const RodRun sor = painleve_rod(contact::Method::sor);
+  const RodRun sor = slide_painleve_rod(contact::Method::sor);
   EXPECT_TRUE(sor.finite);
   EXPECT_GT(sor.steps_with_contact, 100);
   std::printf("Painleve rod: %llu of 3000 SOR steps stopped at max_iterations\n",
@@ -395,7 +370,7 @@ TEST(Conservation, MomentumOfCollidingSpheresWithoutGravityToRoundOff) {
     system.add(sphere_body(id, 0.01, Vector3(x(rng), x(rng), x(rng)), u));
   }
   StaticGeometry statics;
-  const MaterialTable materials = test::one_material(0.4, 0.5, 0.0);
+  const MaterialTable materials = demo::one_material(0.4, 0.5, 0.0);
   StepSettings settings = tight(1e-3);
   settings.I_g.setZero();
   settings.solver.max_iterations = 1000;
@@ -425,8 +400,8 @@ TEST(Conservation, MomentumOfCollidingSpheresWithoutGravityToRoundOff) {
 
 TEST(Identity, PermutingTheBodiesBetweenStepsChangesNothing) {
   const auto setup = [](BodySystem& system, StaticGeometry& statics) {
-    test::add_open_box(statics, 0.12, 0.12);
-    test::add_sphere_lattice(system, 4, 4, 4, 0.01);
+    demo::add_open_box(statics, 0.12, 0.12);
+    demo::add_sphere_lattice(system, 4, 4, 4, 0.01);
   };
   BodySystem a;
   BodySystem b;
@@ -434,7 +409,7 @@ TEST(Identity, PermutingTheBodiesBetweenStepsChangesNothing) {
   StaticGeometry statics_b;
   setup(a, statics);
   setup(b, statics_b);
-  const MaterialTable materials = test::one_material(0.5, 0.2);
+  const MaterialTable materials = demo::one_material(0.5, 0.2);
   StepSettings settings;
   settings.dt = 1e-3;
   settings.solver.max_iterations = 50;
@@ -470,9 +445,9 @@ TEST(Identity, SameInputGivesBitIdenticalOutputAndReorderingKeepsIt) {
   const auto run = [](int reorder_interval) {
     BodySystem system;
     StaticGeometry statics;
-    test::add_open_box(statics, 0.12, 0.12);
-    test::add_sphere_lattice(system, 4, 4, 4, 0.01, 3);
-    const MaterialTable materials = test::one_material(0.5, 0.2);
+    demo::add_open_box(statics, 0.12, 0.12);
+    demo::add_sphere_lattice(system, 4, 4, 4, 0.01, 3);
+    const MaterialTable materials = demo::one_material(0.5, 0.2);
     StepSettings settings;
     settings.dt = 1e-3;
     settings.reorder_interval = reorder_interval;
@@ -502,7 +477,7 @@ TEST(Stepper, RefusesBadSettingsMissingMaterialPairsAndUnsupportedShapePairs) {
   BodySystem system;
   system.add(sphere_body(1, 0.1, Vector3(0.0, 0.0, 1.0)));
   StaticGeometry statics;
-  statics.add(test::floor_object(0, 1));
+  statics.add(demo::floor_object(0, 1));
   MaterialTable materials;
   materials.add("ball");
   materials.add("floor");
@@ -521,8 +496,8 @@ TEST(Stepper, RefusesBadSettingsMissingMaterialPairsAndUnsupportedShapePairs) {
   bad.drift_correction = 2.0;
   EXPECT_THROW(MoreauStepper(system, statics, materials, bad), InvalidArgument);
   materials.set_pair(1, 1, {0.5, 0.0, 0.0});
-  system.add(test::box_body(2, Vector3(0.1, 0.1, 0.1), Vector3(1.0, 0.0, 1.0)));
-  system.add(test::box_body(3, Vector3(0.1, 0.1, 0.1), Vector3(2.0, 0.0, 1.0)));
+  system.add(demo::box_body(2, Vector3(0.1, 0.1, 0.1), Vector3(1.0, 0.0, 1.0)));
+  system.add(demo::box_body(3, Vector3(0.1, 0.1, 0.1), Vector3(2.0, 0.0, 1.0)));
   try {
     MoreauStepper stepper(system, statics, materials);
     ADD_FAILURE() << "two dynamic boxes were accepted";
@@ -535,8 +510,8 @@ TEST(Stepper, ReportsEnergiesPenetrationAndStageTimes) {
   BodySystem system;
   system.add(sphere_body(1, 0.1, Vector3(0.0, 0.0, 0.09)));  // 1 cm into the floor
   StaticGeometry statics;
-  statics.add(test::floor_object());
-  const MaterialTable materials = test::one_material(0.5);
+  statics.add(demo::floor_object());
+  const MaterialTable materials = demo::one_material(0.5);
   MoreauStepper stepper(system, statics, materials, tight(1e-3));
   const StepReport r = stepper.step();
   EXPECT_EQ(r.step, 1u);
@@ -554,9 +529,9 @@ TEST(DriftCorrection, OffKeepsOverlapsOnRemovesThemGeometricallyWithoutVelocity)
   const auto single = [](double beta, int steps) {
     BodySystem system;
     StaticGeometry statics;
-    statics.add(test::floor_object());
+    statics.add(demo::floor_object());
     system.add(sphere_body(1, 0.01, Vector3(0.0, 0.0, 0.0099)));
-    const MaterialTable materials = test::one_material(0.5);
+    const MaterialTable materials = demo::one_material(0.5);
     StepSettings settings = tight(1e-3);
     settings.drift_correction = beta;
     MoreauStepper stepper(system, statics, materials, settings);
@@ -572,12 +547,12 @@ TEST(DriftCorrection, OffKeepsOverlapsOnRemovesThemGeometricallyWithoutVelocity)
   // A column of five: every overlap shrinks, none grows.
   BodySystem system;
   StaticGeometry statics;
-  statics.add(test::floor_object());
+  statics.add(demo::floor_object());
   for (int i = 0; i < 5; ++i) {
     system.add(sphere_body(static_cast<GlobalId>(i + 1), 0.01,
                            Vector3(0.0, 0.0, 0.0099 + 0.0198 * i)));  // overlaps of 0.2 mm
   }
-  const MaterialTable materials = test::one_material(0.5);
+  const MaterialTable materials = demo::one_material(0.5);
   StepSettings settings = tight(1e-3);
   settings.drift_correction = 0.2;
   MoreauStepper stepper(system, statics, materials, settings);

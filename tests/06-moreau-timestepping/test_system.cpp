@@ -21,7 +21,7 @@
 namespace grbd::timestep {
 namespace {
 
-using test::sphere_body;
+using demo::sphere_body;
 
 std::string message_of(const std::function<void()>& f) {
   try {
@@ -151,13 +151,13 @@ TEST(BodySystem, AFixedBodyHasNoVelocityAndNoInverseMass) {
 
 TEST(StaticGeometry, RefusesDuplicateIdsAndBadPoses) {
   StaticGeometry statics;
-  statics.add(test::floor_object(4));
-  EXPECT_NE(message_of([&] { statics.add(test::floor_object(4)); }).find("used twice"),
+  statics.add(demo::floor_object(4));
+  EXPECT_NE(message_of([&] { statics.add(demo::floor_object(4)); }).find("used twice"),
             std::string::npos);
-  StaticObject tilted = test::floor_object(5);
+  StaticObject tilted = demo::floor_object(5);
   tilted.pose.A_IC = 2.0 * Matrix3::Identity();
   EXPECT_NE(message_of([&] { statics.add(tilted); }).find("rotation matrix"), std::string::npos);
-  StaticObject scaled = test::floor_object(6);
+  StaticObject scaled = demo::floor_object(6);
   scaled.shape = collision::HalfSpace{Vector3(0.0, 0.0, 2.0), 1.0};
   statics.add(scaled);
   const auto& h = std::get<collision::HalfSpace>(statics.objects().back().shape);
@@ -221,8 +221,8 @@ TEST(WarmStartTable, FindsEveryStoredKeyAndZeroesNewOnes) {
 TEST(ContactDetector, KeysAndOrderDoNotDependOnTheStorageOrder) {
   BodySystem a;
   StaticGeometry statics;
-  test::add_open_box(statics, 0.1, 0.1);
-  test::add_sphere_lattice(a, 4, 4, 3, 0.01);
+  demo::add_open_box(statics, 0.1, 0.1);
+  demo::add_sphere_lattice(a, 4, 4, 3, 0.01);
   // Squeeze the lattice so that neighbours overlap.
   for (body::State& s : a.states()) s.q.head<3>() *= 0.8;
   BodySystem b = a;
