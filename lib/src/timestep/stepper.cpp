@@ -204,7 +204,11 @@ StepReport MoreauStepper::step() {
     loads_[i].I_F += inertia[i].m * settings_.I_g;
     problem_.u_free[i] = free_velocity(inertia[i], states[i].u, loads_[i], dt);
   }
-  problem_.M_inv.assign(system_.M_inv().begin(), system_.M_inv().end());
+  // M⁻¹ is constant for a layout: copied when bodies were added, removed or reordered.
+  if (M_inv_layout_ != system_.layout_version()) {
+    problem_.M_inv.assign(system_.M_inv().begin(), system_.M_inv().end());
+    M_inv_layout_ = system_.layout_version();
+  }
   const auto t1 = Clock::now();
 
   // 2. Contacts at the midpoint; Moreau's active set g_N(q_M) ≤ 0 (to the tolerance).
@@ -228,7 +232,11 @@ StepReport MoreauStepper::step() {
   problem_.contacts.resize(m);
   problem_.keys.clear();
   G_.resize(m);
-  const auto material_of = [&](std::uint64_t id, std::int32_t collider) {
+  // The material of a side: a dynamic body by its local index; a static object by its index; a
+  // fixed body, which enters as kStatic, by its id.
+  const auto material_of = [&](collision::BodyIndex body, std::uint64_t id,
+                               std::int32_t collider) {
+    if (body != collision::kStatic) return system_.materials()[static_cast<std::size_t>(body)];
     if (id & kStaticTag) return statics_.objects()[static_cast<std::size_t>(collider)].material;
     return system_.materials()[system_.index_of(id)];
   };
@@ -258,7 +266,8 @@ StepReport MoreauStepper::step() {
     }
     cc.gamma_A = start_contact_velocity(u_a ? &cc.W_a : nullptr, u_a, u_b ? &cc.W_b : nullptr, u_b);
     const contact::ContactMaterial& law = materials_.pair_unchecked(
-        material_of(keys_[k].a, c.collider_a), material_of(keys_[k].b, c.collider_b));
+        material_of(c.body_a, keys_[k].a, c.collider_a),
+        material_of(c.body_b, keys_[k].b, c.collider_b));
     cc.mu = law.mu;
     // Newton's law restitutes a closing contact, γ_N,S ≤ 0. A contact closed at the midpoint but
     // already opening at the start (γ_N,S > 0, a resting contact's round-off or the rebound of a

@@ -145,6 +145,7 @@ class MoreauStepper {
   std::uint64_t steps_ = 0;
   std::uint64_t non_converged_ = 0;
   std::uint64_t checked_layout_ = ~std::uint64_t{0};
+  std::uint64_t M_inv_layout_ = ~std::uint64_t{0};  // layout of problem_.M_inv
   double tolerance_ = 0.0;  // contact_tolerance × the smallest bounding radius [m]
 
   std::vector<body::Loads> loads_;
