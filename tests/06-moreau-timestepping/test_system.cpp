@@ -233,8 +233,8 @@ TEST(ContactDetector, KeysAndOrderDoNotDependOnTheStorageOrder) {
   b.permute(order);
   ContactDetector da;
   ContactDetector db;
-  std::vector<collision::Contact> ca;
-  std::vector<collision::Contact> cb;
+  std::vector<DetectedContact> ca;
+  std::vector<DetectedContact> cb;
   std::vector<ContactKey> ka;
   std::vector<ContactKey> kb;
   da.detect(a, statics, 0.0, ca, ka);
@@ -245,8 +245,9 @@ TEST(ContactDetector, KeysAndOrderDoNotDependOnTheStorageOrder) {
     // The same geometry, bit for bit, and side a the body with the smaller id.
     EXPECT_EQ(ca[k].geometry.g_N, cb[k].geometry.g_N);
     EXPECT_EQ(ca[k].geometry.I_n, cb[k].geometry.I_n);
-    EXPECT_EQ(ca[k].I_t1, cb[k].I_t1);
-    EXPECT_EQ(ca[k].K_rho_a, cb[k].K_rho_a);
+    EXPECT_EQ(ca[k].geometry.I_r_a, cb[k].geometry.I_r_a);
+    EXPECT_EQ(ca[k].geometry.I_r_b, cb[k].geometry.I_r_b);
+    EXPECT_EQ(ca[k].material_a, cb[k].material_a);
     if (!(ka[k].b & kStaticTag)) {
       EXPECT_LT(ka[k].a, ka[k].b);
     }

@@ -11,6 +11,8 @@
 
 #include "grbd/contact/solver.hpp"
 
+#include "grbd/contact/compact.hpp"
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -239,6 +241,10 @@ class BodyModel {
   }
   /// What the velocity criterion watches.
   std::span<const double> watched_velocity() const { return flat(std::span<const Vector6>(u_)); }
+  /// Whether every percussion is finite (the divergence test of every iteration).
+  bool lambda_finite() const { return all_finite(lambda_); }
+  /// Λ or u changed outside the model (the hook).
+  void touched() {}
 
  private:
   /// u = u_free + M⁻¹ W Λ, as velocities_from_percussions() computes it.
@@ -322,11 +328,102 @@ class LocalModel {
   }
   /// Nothing to bring up to date: the local form has no body velocities.
   void done() {}
+  /// Whether every percussion is finite (the divergence test of every iteration).
+  bool lambda_finite() const { return all_finite(lambda_); }
+  /// Λ changed outside the model (the hook).
+  void touched() {}
 
  private:
   const LocalProblem& problem_;
   std::span<Vector3> lambda_;
   Workspace& ws_;
+};
+
+/// The compact form (chapter 6): world-frame body velocities and contacts that keep their frame
+/// and lever arms. The same operations as BodyModel, with W applied from (n, t1, r).
+class CompactModel {
+ public:
+  CompactModel(const CompactProblem& problem, std::span<Vector3> lambda, std::vector<Vector6>& u,
+               Workspace& ws)
+      : problem_(problem), lambda_(lambda), u_(u), ws_(ws) {}
+
+  std::size_t size() const { return problem_.contacts.size(); }
+  double mu(std::size_t i) const { return problem_.contacts[i].mu; }
+  /// G_ii, computed when asked (the r-factors ask once per solve): not stored.
+  Matrix3 delassus(std::size_t i) const { return delassus_block(problem_.contacts[i], problem_.M_inv); }
+  std::span<Vector3> lambda() const { return lambda_; }
+  std::span<Vector6> u() const { return u_; }
+
+  void velocities(std::span<const Vector3> lambda, std::vector<Vector3>& xi) {
+    body_velocities(lambda, ws_.v);
+    contact_velocities_of(ws_.v, xi);
+  }
+  void free_velocities(std::vector<Vector3>& xi) {
+    ws_.v.assign(problem_.u_free.begin(), problem_.u_free.end());
+    contact_velocities_of(ws_.v, xi);
+  }
+  void apply_G(std::span<const Vector3> x, std::vector<Vector3>& y) {
+    std::vector<Vector6>& v = ws_.v;
+    v.assign(problem_.M_inv.size(), Vector6::Zero());
+    for (std::size_t i = 0; i < size(); ++i) add_percussion(problem_.contacts[i], x[i], v);
+    y.resize(size());
+    for (std::size_t i = 0; i < size(); ++i) y[i] = contact_velocity(problem_.contacts[i], v);
+  }
+  void synchronize() { body_velocities(lambda_, u_); }
+  void update_u() { synchronize(); }
+  void record(const std::vector<Vector3>& /*xi*/, bool velocity_watched) {
+    if (velocity_watched) synchronize();
+  }
+  void done() { synchronize(); }
+  void sor_sweep(std::span<const RFactors> r, ProxForm form) {
+    sweep_finite_ = contact::sor_sweep(problem_, r, form, u_, lambda_);
+    sweep_fresh_ = true;
+  }
+  std::span<const double> watched_velocity() const { return flat(std::span<const Vector6>(u_)); }
+  /// After a sweep the sweep's own test (no second pass over Λ); else a pass.
+  bool lambda_finite() {
+    if (sweep_fresh_) {
+      sweep_fresh_ = false;
+      return sweep_finite_;
+    }
+    return all_finite(lambda_);
+  }
+  /// The hook may have changed Λ: the sweep's test no longer speaks for it.
+  void touched() { sweep_fresh_ = false; }
+
+ private:
+  /// v_s ± M_s⁻¹ W_s λ for both sides.
+  void add_percussion(const CompactContact& c, const Vector3& lambda,
+                      std::vector<Vector6>& v) const {
+    const auto apply = [&](BodyIndex body, const Vector3& r, double sign) {
+      if (body == kStatic) return;
+      const WorldInverseMass& M = problem_.M_inv[static_cast<std::size_t>(body)];
+      const Vector6 p = side_percussion(c, r, lambda);
+      Vector6& vb = v[static_cast<std::size_t>(body)];
+      vb.head<3>() += sign * M.inv_m * p.head<3>();
+      vb.tail<3>() += sign * (M.I_Theta_inv * p.tail<3>());
+    };
+    apply(c.body_a, c.r_a, 1.0);
+    apply(c.body_b, c.r_b, -1.0);
+  }
+  void body_velocities(std::span<const Vector3> lambda, std::vector<Vector6>& u) const {
+    u.assign(problem_.u_free.begin(), problem_.u_free.end());
+    for (std::size_t i = 0; i < lambda.size(); ++i) add_percussion(problem_.contacts[i], lambda[i], u);
+  }
+  void contact_velocities_of(std::span<const Vector6> u, std::vector<Vector3>& xi) const {
+    xi.resize(size());
+    for (std::size_t i = 0; i < xi.size(); ++i) {
+      const CompactContact& c = problem_.contacts[i];
+      xi[i] = contact_velocity(c, u) + c.xi_A;
+    }
+  }
+
+  const CompactProblem& problem_;
+  std::span<Vector3> lambda_;
+  std::vector<Vector6>& u_;
+  Workspace& ws_;
+  bool sweep_fresh_ = false;
+  bool sweep_finite_ = true;
 };
 
 /// How the power iteration starts.
@@ -434,7 +531,7 @@ class Monitor {
   Verdict after(int k) {
     result_.iterations = k;
     const std::span<const Vector3> lambda = model_.lambda();
-    if (!all_finite(lambda)) {
+    if (!model_.lambda_finite()) {
       result_.diverged = true;
       return Verdict::diverged;
     }
@@ -710,6 +807,7 @@ void iterate(Model& model, Policy& policy, Monitor<Model>& monitor, const Solver
     if (hooks.after_iteration) {
       policy.synchronize_for_hook();
       hooks.after_iteration(k, model.lambda(), model.u());
+      model.touched();
     }
     const Verdict verdict = monitor.after(k);
     if (verdict == Verdict::diverged) break;
@@ -889,6 +987,23 @@ SolverResult ContactSolver::solve_prepared(const ContactProblem& problem,
   }
   return solve_body(method_, problem, G, solution, options_, hooks_, *workspace_,
                     "ContactSolver::solve_prepared");
+}
+
+SolverResult ContactSolver::solve(const CompactProblem& problem, ContactSolution& solution) {
+  validate(problem);
+  return solve_prepared(problem, solution);
+}
+
+SolverResult ContactSolver::solve_prepared(const CompactProblem& problem,
+                                           ContactSolution& solution) {
+  if (problem.u_free.size() != problem.M_inv.size()) {
+    throw InvalidArgument("ContactSolver::solve_prepared: expected one u_free per body; found " +
+                          std::to_string(problem.u_free.size()) + " free velocities for " +
+                          std::to_string(problem.M_inv.size()) + " bodies");
+  }
+  prepare_guess(solution.lambda, problem.contacts.size(), "ContactSolver::solve_prepared");
+  CompactModel model(problem, solution.lambda, solution.u, *workspace_);
+  return run(method_, model, options_, hooks_, *workspace_);
 }
 
 SolverResult ContactSolver::solve(const LocalProblem& problem, std::vector<Vector3>& lambda) {

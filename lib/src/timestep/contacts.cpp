@@ -28,6 +28,63 @@ struct Side {
   std::size_t index = 0;
 };
 
+/// Sorts (code, index) pairs by code, stably: a least-significant-digit radix sort with 16-bit
+/// digits, four passes over the array (digits that are equal in every code are skipped).
+/// O(m), no comparison; `scratch` is resized to m and `count` to 2¹⁶.
+void sort_by_code(std::vector<std::pair<std::uint64_t, std::uint32_t>>& items,
+                  std::vector<std::pair<std::uint64_t, std::uint32_t>>& scratch,
+                  std::vector<std::uint32_t>& count) {
+  constexpr int kBits = 16;
+  constexpr std::size_t kBuckets = std::size_t{1} << kBits;
+  const std::size_t m = items.size();
+  scratch.resize(m);
+  std::uint64_t all_or = 0;
+  std::uint64_t all_and = ~std::uint64_t{0};
+  for (const auto& item : items) {
+    all_or |= item.first;
+    all_and &= item.first;
+  }
+  const std::uint64_t varying = all_or ^ all_and;  // bits that differ between some codes
+  count.resize(kBuckets);
+  for (int shift = 0; shift < 64; shift += kBits) {
+    if (((varying >> shift) & (kBuckets - 1)) == 0) continue;
+    std::fill(count.begin(), count.end(), 0U);
+    for (const auto& item : items) ++count[(item.first >> shift) & (kBuckets - 1)];
+    std::uint32_t offset = 0;
+    for (std::uint32_t& c : count) {
+      const std::uint32_t here = c;
+      c = offset;
+      offset += here;
+    }
+    for (const auto& item : items) scratch[count[(item.first >> shift) & (kBuckets - 1)]++] = item;
+    items.swap(scratch);
+  }
+}
+
+/// Reorders a and b in place so that the new element k is the old element p[k]; p is used up
+/// (each entry becomes its own index as the cycles are followed).
+template <class A, class B>
+void permute_in_place(std::vector<std::uint32_t>& p, std::vector<A>& a, std::vector<B>& b) {
+  for (std::size_t start = 0; start < p.size(); ++start) {
+    if (p[start] == start) continue;
+    A held_a = a[start];
+    B held_b = b[start];
+    std::size_t k = start;
+    for (;;) {
+      const std::size_t from = p[k];
+      p[k] = static_cast<std::uint32_t>(k);
+      if (from == start) {
+        a[k] = held_a;
+        b[k] = held_b;
+        break;
+      }
+      a[k] = a[from];
+      b[k] = b[from];
+      k = from;
+    }
+  }
+}
+
 }  // namespace
 
 std::uint64_t hash(const ContactKey& key) {
@@ -39,7 +96,7 @@ std::uint64_t hash(const ContactKey& key) {
 
 // [detect system]
 void ContactDetector::detect(const BodySystem& system, const StaticGeometry& statics,
-                             double margin, std::vector<collision::Contact>& contacts,
+                             double margin, std::vector<DetectedContact>& contacts,
                              std::vector<ContactKey>& keys) {
   if (!(margin >= 0.0 && std::isfinite(margin))) {
     throw InvalidArgument("ContactDetector::detect: expected a finite margin >= 0, found " +
@@ -56,8 +113,9 @@ void ContactDetector::detect(const BodySystem& system, const StaticGeometry& sta
     placements_[i] = {kinematics::position(q),
                       kinematics::rotation_matrix(kinematics::orientation(q))};
   }
-  unsorted_.clear();
-  unsorted_keys_.clear();
+  contacts.clear();
+  keys.clear();
+  const auto materials = system.materials();
 
   const auto shape_of = [&](const Side& s) -> const collision::Shape& {
     return s.is_body ? shapes[s.index] : objects[s.index].shape;
@@ -78,31 +136,17 @@ void ContactDetector::detect(const BodySystem& system, const StaticGeometry& sta
     collision::collide(shape_of(x), placement_of(x), shape_of(y), placement_of(y), margin, found_);
     for (const collision::ContactGeometry& g : found_) {
       if (!(g.g_N <= margin)) continue;
-      collision::Contact c;
+      DetectedContact c;
       c.geometry = g;
-      const Eigen::Matrix<double, 3, 2> T = collision::tangent_basis(g.I_n);
-      c.I_t1 = T.col(0);
-      c.I_t2 = T.col(1);
-      const auto side = [&](const Side& s, const Vector3& I_r, collision::BodyIndex& body,
-                            std::int32_t& collider, Vector3& K_rho) {
-        if (!s.is_body) {
-          body = collision::kStatic;
-          collider = static_cast<std::int32_t>(s.index);
-          return;
-        }
-        collider = -1;
-        if (!system.dynamic(s.index)) {
-          body = collision::kStatic;
-          return;
-        }
-        body = static_cast<collision::BodyIndex>(s.index);
-        const collision::Placement& p = placements_[s.index];
-        K_rho = p.A_IC.transpose() * (I_r - p.I_r);
+      const auto side = [&](const Side& s, collision::BodyIndex& body, MaterialId& material) {
+        body = s.is_body && system.dynamic(s.index) ? static_cast<collision::BodyIndex>(s.index)
+                                                    : collision::kStatic;
+        material = s.is_body ? materials[s.index] : objects[s.index].material;
       };
-      side(x, g.I_r_a, c.body_a, c.collider_a, c.K_rho_a);
-      side(y, g.I_r_b, c.body_b, c.collider_b, c.K_rho_b);
-      unsorted_.push_back(c);
-      unsorted_keys_.push_back({id_of(x), id_of(y), g.feature_a, g.feature_b});
+      side(x, c.body_a, c.material_a);
+      side(y, c.body_b, c.material_b);
+      contacts.push_back(c);
+      keys.push_back({id_of(x), id_of(y), g.feature_a, g.feature_b});
     }
   };
 
@@ -167,25 +211,32 @@ void ContactDetector::detect(const BodySystem& system, const StaticGeometry& sta
   // The canonical order: along the Morton curve of the contact points (the midpoint of the two
   // closest points), on the finest grid of their bounding box, 2²¹ cells along its longest axis,
   // ties broken by key.
-  const std::size_t m = unsorted_.size();
+  const std::size_t m = contacts.size();
   midpoints_.resize(m);
   for (std::size_t k = 0; k < m; ++k) {
-    midpoints_[k] = 0.5 * (unsorted_[k].geometry.I_r_a + unsorted_[k].geometry.I_r_b);
+    midpoints_[k] = 0.5 * (contacts[k].geometry.I_r_a + contacts[k].geometry.I_r_b);
   }
   codes_.resize(m);
   collision::morton_codes(midpoints_, std::numeric_limits<double>::min(), codes_);
   order_.resize(m);
   for (std::size_t k = 0; k < m; ++k) order_[k] = {codes_[k], static_cast<std::uint32_t>(k)};
-  std::sort(order_.begin(), order_.end(), [&](const auto& x, const auto& y) {
-    if (x.first != y.first) return x.first < y.first;
-    return unsorted_keys_[x.second] < unsorted_keys_[y.second];
-  });
-  contacts.resize(m);
-  keys.resize(m);
-  for (std::size_t k = 0; k < m; ++k) {
-    contacts[k] = unsorted_[order_[k].second];
-    keys[k] = unsorted_keys_[order_[k].second];
+  sort_by_code(order_, scratch_, counts_);
+  // Equal codes (two contacts of one pair, or points closer than a cell): by key.
+  for (std::size_t lo = 0; lo < m;) {
+    std::size_t hi = lo + 1;
+    while (hi < m && order_[hi].first == order_[lo].first) ++hi;
+    if (hi - lo > 1) {
+      std::sort(order_.begin() + static_cast<std::ptrdiff_t>(lo),
+                order_.begin() + static_cast<std::ptrdiff_t>(hi),
+                [&](const auto& x, const auto& y) { return keys[x.second] < keys[y.second]; });
+    }
+    lo = hi;
   }
+  // Contact k of the canonical order is found contact order_[k]: moved in place along the
+  // cycles of the permutation.
+  permutation_.resize(m);
+  for (std::size_t k = 0; k < m; ++k) permutation_[k] = order_[k].second;
+  permute_in_place(permutation_, contacts, keys);
 }
 // [detect system]
 

@@ -14,6 +14,7 @@
 #include "grbd/core/checks.hpp"
 #include "grbd/core/error.hpp"
 #include "grbd/kinematics/rigid_motion.hpp"
+#include "grbd/kinematics/rotation.hpp"
 #include "grbd/timestep/midpoint.hpp"
 
 namespace grbd::timestep {
@@ -195,19 +196,29 @@ StepReport MoreauStepper::step() {
                                           id_name(system_.ids()[i]));
     }
   }
+  // The contact problem is written in the world frame (contact::CompactProblem): at q_M each
+  // body's inverse inertia A K_Θ⁻¹ Aᵀ, and u_free and u_S with ω in frame I. solution_.u holds
+  // u_S until the solver overwrites it with u_E.
+  problem_.M_inv.resize(n);
   problem_.u_free.resize(n);
+  solution_.u.resize(n);
+  const auto M_inv = system_.M_inv();
+  problem_.isotropic = true;
   for (std::size_t i = 0; i < n; ++i) {
     if (!system_.dynamic(i)) {
+      problem_.M_inv[i] = {};
       problem_.u_free[i].setZero();
+      solution_.u[i].setZero();
       continue;
     }
     loads_[i].I_F += inertia[i].m * settings_.I_g;
-    problem_.u_free[i] = free_velocity(inertia[i], states[i].u, loads_[i], dt);
-  }
-  // M⁻¹ is constant for a layout: copied when bodies were added, removed or reordered.
-  if (M_inv_layout_ != system_.layout_version()) {
-    problem_.M_inv.assign(system_.M_inv().begin(), system_.M_inv().end());
-    M_inv_layout_ = system_.layout_version();
+    const Vector6 u_free = free_velocity(inertia[i], states[i].u, loads_[i], dt);
+    const Matrix3 A_IK = kinematics::rotation_matrix(kinematics::orientation(states[i].q));
+    problem_.M_inv[i] = contact::world_inverse_mass(M_inv[i], A_IK);
+    const Matrix3& T = problem_.M_inv[i].I_Theta_inv;
+    problem_.isotropic = problem_.isotropic && T == T(0, 0) * Matrix3::Identity();
+    problem_.u_free[i] << u_free.head<3>(), A_IK * u_free.tail<3>();
+    solution_.u[i] << states[i].u.head<3>(), A_IK * states[i].u.tail<3>();
   }
   const auto t1 = Clock::now();
 
@@ -226,63 +237,38 @@ StepReport MoreauStepper::step() {
   keys_.resize(active);
   const auto t2 = Clock::now();
 
-  // 3. The contact problem at q_M: W, γ_S with the velocities at the start, the materials of the
-  // pair, the Delassus blocks once (the solver takes them as they are).
+  // 3. The contact problem at q_M: the frame and the lever arms of each contact, γ_S from the
+  // velocities at the start, the materials of the pair.
   const std::size_t m = contacts_.size();
   problem_.contacts.resize(m);
-  problem_.keys.clear();
-  G_.resize(m);
-  // The material of a side: a dynamic body by its local index; a static object by its index; a
-  // fixed body, which enters as kStatic, by its id.
-  const auto material_of = [&](collision::BodyIndex body, std::uint64_t id,
-                               std::int32_t collider) {
-    if (body != collision::kStatic) return system_.materials()[static_cast<std::size_t>(body)];
-    if (id & kStaticTag) return statics_.objects()[static_cast<std::size_t>(collider)].material;
-    return system_.materials()[system_.index_of(id)];
-  };
   for (std::size_t k = 0; k < m; ++k) {
-    const collision::Contact& c = contacts_[k];
-    contact::ContactConstraint& cc = problem_.contacts[k];
+    const DetectedContact& c = contacts_[k];
+    contact::CompactContact& cc = problem_.contacts[k];
     cc.body_a = c.body_a;
     cc.body_b = c.body_b;
-    const Vector3& n_ = c.geometry.I_n;
-    const Vector6* u_a = nullptr;
-    const Vector6* u_b = nullptr;
-    if (c.body_a != collision::kStatic) {
-      const body::State& s = states[static_cast<std::size_t>(c.body_a)];
-      cc.W_a = collision::contact_jacobian(kinematics::orientation(s.q), c.K_rho_a, n_, c.I_t1,
-                                           c.I_t2);
-      u_a = &s.u;
-    } else {
-      cc.W_a.setZero();
-    }
-    if (c.body_b != collision::kStatic) {
-      const body::State& s = states[static_cast<std::size_t>(c.body_b)];
-      cc.W_b = collision::contact_jacobian(kinematics::orientation(s.q), c.K_rho_b, n_, c.I_t1,
-                                           c.I_t2);
-      u_b = &s.u;
-    } else {
-      cc.W_b.setZero();
-    }
-    cc.gamma_A = start_contact_velocity(u_a ? &cc.W_a : nullptr, u_a, u_b ? &cc.W_b : nullptr, u_b);
-    const contact::ContactMaterial& law = materials_.pair_unchecked(
-        material_of(c.body_a, keys_[k].a, c.collider_a),
-        material_of(c.body_b, keys_[k].b, c.collider_b));
+    cc.n = c.geometry.I_n;
+    cc.t1 = collision::tangent_basis(cc.n).col(0);
+    const auto lever = [&](collision::BodyIndex body, const Vector3& I_r) -> Vector3 {
+      if (body == collision::kStatic) return Vector3::Zero();
+      return I_r - states[static_cast<std::size_t>(body)].q.head<3>();
+    };
+    cc.r_a = lever(c.body_a, c.geometry.I_r_a);
+    cc.r_b = lever(c.body_b, c.geometry.I_r_b);
+    cc.xi_A.setZero();
+    const Vector3 gamma_S = contact::contact_velocity(cc, solution_.u);
+    const contact::ContactMaterial& law = materials_.pair_unchecked(c.material_a, c.material_b);
     cc.mu = law.mu;
     // Newton's law restitutes a closing contact, γ_N,S ≤ 0. A contact closed at the midpoint but
     // already opening at the start (γ_N,S > 0, a resting contact's round-off or the rebound of a
     // penetrating one) takes ε_N = 1: then λ_N > 0 gives γ_N,E = −γ_N,S, and the percussion, which
     // works on the mean velocity (γ_N,S + γ_N,E)/2 of the step, does no work. With its own ε_N < 1
     // it would do positive work and the energy of a ball at rest would creep up.
-    cc.eps_N = cc.gamma_A(0) > 0.0 ? 1.0 : law.eps_N;
-    cc.eps_T = law.eps_T;
-    G_[k] = contact::delassus_block(cc, problem_.M_inv);
-    if (!(G_[k](0, 0) > 0.0 && G_[k](1, 1) > 0.0 && G_[k](2, 2) > 0.0) || !G_[k].allFinite() ||
-        !cc.gamma_A.allFinite()) {
+    const double eps_N = gamma_S(0) > 0.0 ? 1.0 : law.eps_N;
+    cc.xi_A = {eps_N * gamma_S(0), law.eps_T * gamma_S(1), law.eps_T * gamma_S(2)};
+    if (!cc.xi_A.allFinite() || !cc.r_a.allFinite() || !cc.r_b.allFinite()) {
       throw Error("MoreauStepper: step " + std::to_string(report.step) + ": the contact of " +
                   id_name(keys_[k].a) + " and " + id_name(keys_[k].b) +
-                  " has a Delassus block without a positive finite diagonal or a non-finite "
-                  "velocity");
+                  " has a non-finite lever arm or velocity");
     }
   }
   solution_.lambda.resize(m);
@@ -296,7 +282,7 @@ StepReport MoreauStepper::step() {
   // 4. The contact problem.
   report.contacts = m;
   if (m > 0) {
-    const contact::SolverResult result = solver_.solve_prepared(problem_, G_, solution_);
+    const contact::SolverResult result = solver_.solve_prepared(problem_, solution_);
     report.iterations = result.iterations;
     report.residual = result.residual;
     report.converged = result.converged;
@@ -325,7 +311,16 @@ StepReport MoreauStepper::step() {
   // 5. u_E, q_E = q_M + Δt/2 F(q_M) u_E.
   for (std::size_t i = 0; i < n; ++i) {
     if (!system_.dynamic(i)) continue;
-    states[i].u = solution_.u[i];
+    // Only the change of ω goes back to frame K: ω_K,E = ω_K,S + A_IKᵀ(ω_I,E − A_IK ω_K,S),
+    // with A_IK ω_K,S formed exactly as in the assembly. A body the contacts leave alone keeps
+    // its ω_K to the bit, and the rounding of A_IK (‖p‖ drifts from 1 by 10⁻¹⁴ over thousands of
+    // exp-map steps, so A_IKᵀ A_IK ≠ I) touches the change only, never the whole ω: a rolling ball
+    // does not pick up slip of 10⁻¹³ m/s per step.
+    const Matrix3 A_IK = kinematics::rotation_matrix(kinematics::orientation(states[i].q));
+    const Vector6& u_E = solution_.u[i];
+    const Vector3 I_omega_S = A_IK * states[i].u.tail<3>();
+    states[i].u.head<3>() = u_E.head<3>();
+    states[i].u.tail<3>() += A_IK.transpose() * (u_E.tail<3>() - I_omega_S);
     states[i].q = half(states[i].q, states[i].u);
   }
   if (settings_.drift_correction > 0.0) correct_drift();
@@ -335,7 +330,7 @@ StepReport MoreauStepper::step() {
     report.kinetic_energy += body::kinetic_energy(inertia[i], states[i].u);
     report.potential_energy -= inertia[i].m * settings_.I_g.dot(states[i].q.head<3>());
   }
-  for (const collision::Contact& c : contacts_) {
+  for (const DetectedContact& c : contacts_) {
     report.max_penetration = std::max(report.max_penetration, -c.geometry.g_N);
   }
   t_ += dt;
@@ -353,12 +348,12 @@ void MoreauStepper::correct_drift() {
   shift_.assign(n, Vector3::Zero());
   share_.assign(n, 0);
   const auto M_inv = system_.M_inv();
-  for (const collision::Contact& c : contacts_) {
+  for (const DetectedContact& c : contacts_) {
     if (!(c.geometry.g_N < 0.0)) continue;
     if (c.body_a != collision::kStatic) ++share_[static_cast<std::size_t>(c.body_a)];
     if (c.body_b != collision::kStatic) ++share_[static_cast<std::size_t>(c.body_b)];
   }
-  for (const collision::Contact& c : contacts_) {
+  for (const DetectedContact& c : contacts_) {
     if (!(c.geometry.g_N < 0.0)) continue;
     const double w_a = c.body_a != collision::kStatic
                            ? M_inv[static_cast<std::size_t>(c.body_a)].inv_m : 0.0;

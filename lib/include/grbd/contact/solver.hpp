@@ -19,6 +19,7 @@
 #include <string_view>
 #include <vector>
 
+#include "grbd/contact/compact.hpp"
 #include "grbd/contact/local_problem.hpp"
 #include "grbd/contact/problem.hpp"
 #include "grbd/core/types.hpp"
@@ -238,6 +239,15 @@ class ContactSolver {
   /// to solve().
   SolverResult solve_prepared(const ContactProblem& problem, std::span<const Matrix3> G,
                               ContactSolution& solution);
+  /// The compact form of chapter 6 (world-frame velocities: `solution.u` is (I_v, I_ω) per body):
+  /// validates the problem (contact::validate(const CompactProblem&)), then solves as
+  /// solve_prepared() does.
+  SolverResult solve(const CompactProblem& problem, ContactSolution& solution);
+  /// The compact form for a problem the caller has already validated: only the sizes and the
+  /// initial guess are checked. G_ii is formed from the frame and lever arms when the r-factors
+  /// need it (once per solve), and SOR tests for divergence inside its sweep. What
+  /// timestep::MoreauStepper calls once per step.
+  SolverResult solve_prepared(const CompactProblem& problem, ContactSolution& solution);
   /// The local form (FCLIB): validates the problem, then solves; `lambda` is the initial guess on
   /// entry (empty means zero) and the result on return. after_iteration gets an empty u.
   SolverResult solve(const LocalProblem& problem, std::vector<Vector3>& lambda);

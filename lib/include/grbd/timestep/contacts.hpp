@@ -31,6 +31,19 @@ struct ContactKey {
   friend auto operator<=>(const ContactKey&, const ContactKey&) = default;
 };
 
+/// A contact as detection finds it: the two sides as the contact problem sees them, their
+/// materials, and the geometry at the detected states (normal from b towards a, gap, the two
+/// closest points, features). 112 bytes: no tangent basis, no lever arms in body frames (the
+/// stepper forms the compact problem of contact::CompactProblem from it).
+struct DetectedContact {
+  /// a dynamic body's local index, or collision::kStatic (a static object or a fixed body)
+  collision::BodyIndex body_a = collision::kStatic;
+  collision::BodyIndex body_b = collision::kStatic;  ///< as body_a, for side b
+  MaterialId material_a = 0;                         ///< material of side a
+  MaterialId material_b = 0;                         ///< material of side b
+  collision::ContactGeometry geometry;               ///< n, g_N, points, features
+};
+
 /// Contact detection for a BodySystem and its StaticGeometry. Every buffer is a member and keeps
 /// its capacity, so that detection in a settled system allocates nothing.
 ///
@@ -41,12 +54,12 @@ struct ContactKey {
 /// solver computes from it, does not depend on how the bodies are stored.
 class ContactDetector {
  public:
-  /// All contacts with g_N ≤ margin at the states of `system`, each with its tangent basis and
-  /// lever arms, and their keys (same length); both vectors are overwritten. A fixed body enters
-  /// its contacts as collision::kStatic (it does not move), with its global id in the key. The
-  /// collider fields of the contacts hold −1 (body sides) or the static object's index.
+  /// All contacts with g_N ≤ margin at the states of `system` and their keys (same length); both
+  /// vectors are overwritten, written in place and then put in canonical order in place (no
+  /// second copy of the contacts). A fixed body enters its contacts as collision::kStatic (it
+  /// does not move), with its global id in the key and its material.
   void detect(const BodySystem& system, const StaticGeometry& statics, double margin,
-              std::vector<collision::Contact>& contacts, std::vector<ContactKey>& keys);
+              std::vector<DetectedContact>& contacts, std::vector<ContactKey>& keys);
 
  private:
   collision::CellGrid grid_;
@@ -57,11 +70,11 @@ class ContactDetector {
   std::vector<std::size_t> others_;  // dynamic non-spheres and fixed bodies
   std::vector<collision::Placement> placements_;
   std::vector<collision::ContactGeometry> found_;
-  std::vector<collision::Contact> unsorted_;
-  std::vector<ContactKey> unsorted_keys_;
   std::vector<Vector3> midpoints_;
   std::vector<std::uint64_t> codes_;
-  std::vector<std::pair<std::uint64_t, std::uint32_t>> order_;
+  std::vector<std::pair<std::uint64_t, std::uint32_t>> order_, scratch_;
+  std::vector<std::uint32_t> permutation_;
+  std::vector<std::uint32_t> counts_;  // radix-sort buckets
 };
 
 /// The percussions of the previous step, keyed by ContactKey, in flat arrays: store() copies

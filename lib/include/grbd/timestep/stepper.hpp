@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "grbd/collision/contact.hpp"
+#include "grbd/contact/compact.hpp"
 #include "grbd/contact/problem.hpp"
 #include "grbd/contact/solver.hpp"
 #include "grbd/timestep/body_system.hpp"
@@ -61,7 +62,7 @@ struct StepSettings {
 struct StepTimes {
   double midpoint = 0.0;   ///< first half step, free velocities
   double detection = 0.0;  ///< collision detection at q_M
-  double assembly = 0.0;   ///< W, γ_S, G_ii, materials, warm start
+  double assembly = 0.0;   ///< world-frame M⁻¹ and velocities, contact frames, γ_S, materials, warm start
   double solve = 0.0;      ///< the contact solver
   double update = 0.0;     ///< end velocities, second half step, warm-start store, energies
   double total = 0.0;      ///< the whole step
@@ -120,12 +121,12 @@ class MoreauStepper {
 
   /// \name The last step
   /// Contacts (at the midpoint, canonical order), their keys and percussions, and the contact
-  /// problem that was solved.
+  /// problem that was solved, in the compact form (world-frame velocities).
   ///@{
-  std::span<const collision::Contact> contacts() const { return contacts_; }  ///< at q_M
+  std::span<const DetectedContact> contacts() const { return contacts_; }  ///< at q_M
   std::span<const ContactKey> keys() const { return keys_; }  ///< one per contact
   std::span<const Vector3> percussions() const { return solution_.lambda; }  ///< λ per contact
-  const contact::ContactProblem& problem() const { return problem_; }  ///< the problem solved
+  const contact::CompactProblem& problem() const { return problem_; }  ///< the problem solved
   ///@}
   /// The warm starts (chapter 7 saves and restores them).
   WarmStartTable& warm_starts() { return warm_; }
@@ -145,15 +146,13 @@ class MoreauStepper {
   std::uint64_t steps_ = 0;
   std::uint64_t non_converged_ = 0;
   std::uint64_t checked_layout_ = ~std::uint64_t{0};
-  std::uint64_t M_inv_layout_ = ~std::uint64_t{0};  // layout of problem_.M_inv
   double tolerance_ = 0.0;  // contact_tolerance × the smallest bounding radius [m]
 
   std::vector<body::Loads> loads_;
-  std::vector<collision::Contact> contacts_;
+  std::vector<DetectedContact> contacts_;
   std::vector<ContactKey> keys_;
-  contact::ContactProblem problem_;
-  std::vector<Matrix3> G_;
-  contact::ContactSolution solution_;
+  contact::CompactProblem problem_;
+  contact::ContactSolution solution_;  // world-frame u; before the solve, u_S (for γ_S)
   std::vector<Vector3> shift_;      // drift correction: displacement per body
   std::vector<std::uint32_t> share_;  // drift correction: contacts per body
 };

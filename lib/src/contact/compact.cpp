@@ -1,0 +1,176 @@
+/// \file
+/// \brief The compact (world-frame) contact problem: inverse masses, validation, Delassus blocks
+/// and the kernels of its model. The SOR sweep lives beside chapter 5's in
+/// solutions/05-contact-laws/prox.cpp, where the prox updates it repeats can be inlined.
+
+#include "grbd/contact/compact.hpp"
+
+#include <cmath>
+#include <string>
+
+#include "grbd/core/checks.hpp"
+#include "grbd/core/error.hpp"
+
+namespace grbd::contact {
+
+namespace {
+
+[[noreturn]] void refuse(const std::string& what) {
+  throw InvalidArgument("compact contact problem: " + what);
+}
+
+std::string contact_name(std::size_t i) { return "contact " + std::to_string(i); }
+
+}  // namespace
+
+WorldInverseMass world_inverse_mass(const InverseMass& M_inv, const Matrix3& A_IK) {
+  WorldInverseMass w;
+  w.inv_m = M_inv.inv_m;
+  const Vector3& d = M_inv.K_Theta_inv;
+  if (d(0) == d(1) && d(1) == d(2)) {
+    w.I_Theta_inv = d(0) * Matrix3::Identity();
+  } else {
+    w.I_Theta_inv = A_IK * d.asDiagonal() * A_IK.transpose();
+    // Symmetric to the last bit, so that G_ii is.
+    w.I_Theta_inv = 0.5 * (w.I_Theta_inv + w.I_Theta_inv.transpose()).eval();
+  }
+  return w;
+}
+
+void validate(const CompactProblem& problem) {
+  const std::size_t bodies = problem.M_inv.size();
+  if (problem.u_free.size() != bodies) {
+    refuse("M_inv has " + std::to_string(bodies) + " bodies but u_free has " +
+           std::to_string(problem.u_free.size()));
+  }
+  for (std::size_t b = 0; b < bodies; ++b) {
+    const WorldInverseMass& M = problem.M_inv[b];
+    if (!(M.inv_m > 0.0) || !std::isfinite(M.inv_m)) {
+      refuse("body " + std::to_string(b) + ": expected a finite 1/m > 0, found " +
+             format_number(M.inv_m));
+    }
+    if (!M.I_Theta_inv.allFinite() || !(M.I_Theta_inv.diagonal().minCoeff() > 0.0) ||
+        !M.I_Theta_inv.isApprox(M.I_Theta_inv.transpose(), 1e-12)) {
+      refuse("body " + std::to_string(b) +
+             ": expected a finite symmetric I_Theta_inv with a positive diagonal");
+    }
+    if (problem.isotropic && M.I_Theta_inv != M.I_Theta_inv(0, 0) * Matrix3::Identity()) {
+      refuse("body " + std::to_string(b) +
+             ": the problem is marked isotropic but I_Theta_inv is not a multiple of I");
+    }
+    if (!problem.u_free[b].allFinite()) refuse("body " + std::to_string(b) + ": u_free is not finite");
+  }
+  for (std::size_t i = 0; i < problem.contacts.size(); ++i) {
+    const CompactContact& c = problem.contacts[i];
+    const auto check = [&](BodyIndex body, const char* side) {
+      if (body != kStatic && (body < 0 || static_cast<std::size_t>(body) >= bodies)) {
+        refuse(contact_name(i) + ": body_" + side + " = " + std::to_string(body) +
+               " is neither kStatic (-1) nor a body index in [0, " + std::to_string(bodies) +
+               ")");
+      }
+    };
+    check(c.body_a, "a");
+    check(c.body_b, "b");
+    if (c.body_a == kStatic && c.body_b == kStatic) refuse(contact_name(i) + ": both sides are static");
+    if (c.body_a == c.body_b) {
+      refuse(contact_name(i) + ": body " + std::to_string(c.body_a) + " touches itself");
+    }
+    if (!c.n.allFinite() || !c.t1.allFinite() || !c.r_a.allFinite() || !c.r_b.allFinite() ||
+        !c.xi_A.allFinite()) {
+      refuse(contact_name(i) + ": n, t1, r_a, r_b and xi_A must be finite");
+    }
+    if (std::abs(c.n.norm() - 1.0) > 1e-9 || std::abs(c.t1.norm() - 1.0) > 1e-9 ||
+        std::abs(c.n.dot(c.t1)) > 1e-9) {
+      refuse(contact_name(i) + ": expected a unit normal n and a unit tangent t1 ⟂ n, found |n| = " +
+             format_number(c.n.norm()) + ", |t1| = " + format_number(c.t1.norm()) +
+             ", n·t1 = " + format_number(c.n.dot(c.t1)));
+    }
+    if (!(c.mu >= 0.0) || !std::isfinite(c.mu)) {
+      refuse(contact_name(i) + ": expected a finite friction coefficient mu >= 0, found " +
+             format_number(c.mu));
+    }
+  }
+}
+
+Matrix3 delassus_block(const CompactContact& c, std::span<const WorldInverseMass> M_inv) {
+  const Vector3 t2 = c.t2();
+  Matrix3 G = Matrix3::Zero();
+  const auto add = [&](BodyIndex body, const Vector3& r) {
+    if (body == kStatic) return;
+    const WorldInverseMass& M = M_inv[static_cast<std::size_t>(body)];
+    Matrix3 C;
+    C.col(0) = r.cross(c.n);
+    C.col(1) = r.cross(c.t1);
+    C.col(2) = r.cross(t2);
+    G += M.inv_m * Matrix3::Identity() + C.transpose() * M.I_Theta_inv * C;
+  };
+  add(c.body_a, c.r_a);
+  add(c.body_b, c.r_b);
+  return G;
+}
+
+Vector3 contact_velocity(const CompactContact& c, std::span<const Vector6> u) {
+  Vector3 w = Vector3::Zero();
+  if (c.body_a != kStatic) {
+    const Vector6& ua = u[static_cast<std::size_t>(c.body_a)];
+    w += ua.head<3>() + ua.tail<3>().cross(c.r_a);
+  }
+  if (c.body_b != kStatic) {
+    const Vector6& ub = u[static_cast<std::size_t>(c.body_b)];
+    w -= ub.head<3>() + ub.tail<3>().cross(c.r_b);
+  }
+  return {c.n.dot(w), c.t1.dot(w), c.t2().dot(w)};
+}
+
+Vector6 side_percussion(const CompactContact& c, const Vector3& r_side, const Vector3& lambda) {
+  const Vector3 P = c.n * lambda(0) + c.t1 * lambda(1) + c.t2() * lambda(2);
+  Vector6 out;
+  out << P, r_side.cross(P);
+  return out;
+}
+
+ContactProblem body_form(const CompactProblem& problem, std::span<const InverseMass> M_inv,
+                         std::span<const Matrix3> A_IK) {
+  const std::size_t n = problem.M_inv.size();
+  if (M_inv.size() != n || A_IK.size() != n || problem.u_free.size() != n) {
+    throw InvalidArgument("body_form: expected " + std::to_string(n) +
+                          " inverse masses, orientations and free velocities (one per body), "
+                          "found " + std::to_string(M_inv.size()) + ", " +
+                          std::to_string(A_IK.size()) + " and " +
+                          std::to_string(problem.u_free.size()));
+  }
+  ContactProblem out;
+  out.M_inv.assign(M_inv.begin(), M_inv.end());
+  out.u_free.resize(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    out.u_free[i] << problem.u_free[i].head<3>(), A_IK[i].transpose() * problem.u_free[i].tail<3>();
+  }
+  out.contacts.resize(problem.contacts.size());
+  for (std::size_t k = 0; k < problem.contacts.size(); ++k) {
+    const CompactContact& c = problem.contacts[k];
+    ContactConstraint& cc = out.contacts[k];
+    cc.body_a = c.body_a;
+    cc.body_b = c.body_b;
+    const Vector3 d[3] = {c.n, c.t1, c.t2()};
+    const auto jacobian = [&](BodyIndex body, const Vector3& r, collision::ContactJacobian& W) {
+      W.setZero();
+      if (body == kStatic) return;
+      if (body < 0 || static_cast<std::size_t>(body) >= n) {
+        throw InvalidArgument("body_form: contact " + std::to_string(k) + ": body index " +
+                              std::to_string(body) + " out of range");
+      }
+      for (int j = 0; j < 3; ++j) {
+        W.col(j) << d[j], A_IK[static_cast<std::size_t>(body)].transpose() * r.cross(d[j]);
+      }
+    };
+    jacobian(c.body_a, c.r_a, cc.W_a);
+    jacobian(c.body_b, c.r_b, cc.W_b);
+    cc.gamma_A = c.xi_A;
+    cc.mu = c.mu;
+    cc.eps_N = 1.0;
+    cc.eps_T = 1.0;
+  }
+  return out;
+}
+
+}  // namespace grbd::contact

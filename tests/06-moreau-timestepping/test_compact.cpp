@@ -1,0 +1,215 @@
+/// \file
+/// \brief The compact (world-frame) contact problem that the stepper solves, checked against the
+/// body form of chapter 5 (validated there on closed forms and FCLIB problems): the same contact
+/// velocities, Delassus blocks and solutions for bodies of any inertia and orientation; the
+/// isotropic fast path; divergence caught inside the sweep; validation messages.
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "grbd/contact/compact.hpp"
+#include "grbd/contact/prox.hpp"
+#include "grbd/contact/solver.hpp"
+#include "grbd/core/error.hpp"
+#include "grbd/kinematics/quaternion.hpp"
+#include "grbd/kinematics/rotation.hpp"
+
+namespace grbd::contact {
+namespace {
+
+/// A random compact problem: `bodies` bodies with distinct principal moments (or equal ones when
+/// `isotropic`), random orientations, velocities and contacts, some against the static world.
+struct Random {
+  CompactProblem problem;
+  std::vector<InverseMass> M_inv;   // principal frame
+  std::vector<Matrix3> A_IK;
+};
+
+Random random_problem(int bodies, int contacts, bool isotropic, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  std::uniform_real_distribution<double> positive(0.5, 2.0);
+  const auto vec = [&] { return Vector3(unit(rng), unit(rng), unit(rng)); };
+  Random out;
+  for (int b = 0; b < bodies; ++b) {
+    InverseMass M;
+    M.inv_m = positive(rng);
+    M.K_Theta_inv = isotropic ? Vector3::Constant(positive(rng))
+                              : Vector3(positive(rng), positive(rng), positive(rng));
+    kinematics::Quaternion p(unit(rng), unit(rng), unit(rng), unit(rng));
+    p = p.normalized();
+    const Matrix3 A = kinematics::rotation_matrix(p);
+    out.M_inv.push_back(M);
+    out.A_IK.push_back(A);
+    out.problem.M_inv.push_back(world_inverse_mass(M, A));
+    Vector6 u;
+    u << vec(), vec();
+    out.problem.u_free.push_back(u);
+  }
+  std::uniform_int_distribution<int> pick(-1, bodies - 1);
+  for (int k = 0; k < contacts; ++k) {
+    CompactContact c;
+    do {
+      c.body_a = pick(rng);
+      c.body_b = pick(rng);
+    } while (c.body_a == c.body_b || c.body_a == kStatic);
+    c.n = vec().normalized();
+    c.t1 = c.n.cross(vec()).normalized();
+    c.r_a = vec();
+    c.r_b = vec();
+    c.xi_A = 0.1 * vec();
+    c.mu = 0.3 * positive(rng);
+    out.problem.contacts.push_back(c);
+  }
+  out.problem.isotropic = isotropic;
+  return out;
+}
+
+TEST(CompactProblem, HasTheContactVelocitiesAndDelassusBlocksOfTheBodyForm) {
+  const Random r = random_problem(6, 20, false, 3);
+  validate(r.problem);
+  const ContactProblem body = body_form(r.problem, r.M_inv, r.A_IK);
+  validate(body);
+  // Body velocities with ω in frame K for the body form, in frame I for the compact form.
+  std::vector<Vector6> u_K(r.problem.u_free.size());
+  for (std::size_t b = 0; b < u_K.size(); ++b) {
+    u_K[b] << r.problem.u_free[b].head<3>(), r.A_IK[b].transpose() * r.problem.u_free[b].tail<3>();
+  }
+  const std::vector<Vector3> xi_body = contact_velocities(body, u_K);
+  for (std::size_t i = 0; i < r.problem.contacts.size(); ++i) {
+    const CompactContact& c = r.problem.contacts[i];
+    const Vector3 xi = contact_velocity(c, r.problem.u_free) + c.xi_A;
+    EXPECT_LE((xi - xi_body[i]).norm(), 1e-13) << "contact " << i;
+    const Matrix3 G = delassus_block(c, r.problem.M_inv);
+    const Matrix3 G_body = delassus_block(body.contacts[i], body.M_inv);
+    EXPECT_LE((G - G_body).norm(), 1e-13 * G_body.norm()) << "contact " << i;
+    EXPECT_LE((G - G.transpose()).norm(), 1e-15 * G.norm());
+  }
+}
+
+TEST(CompactProblem, SolvesToTheSolutionOfTheBodyFormWithEveryMethod) {
+  const Random r = random_problem(8, 24, false, 5);
+  const ContactProblem body = body_form(r.problem, r.M_inv, r.A_IK);
+  SolverOptions options;
+  options.abs_tol = 1e-14;
+  options.rel_tol = 1e-12;
+  options.max_iterations = 200000;
+  options.criterion = Criterion::natural_residual;
+  for (const Method method : {Method::sor, Method::jor, Method::apgd}) {
+    ContactSolution compact_solution;
+    ContactSolution body_solution;
+    ContactSolver compact_solver(method, options);
+    ContactSolver body_solver(method, options);
+    const SolverResult a = compact_solver.solve(r.problem, compact_solution);
+    const SolverResult b = body_solver.solve(body, body_solution);
+    ASSERT_TRUE(a.converged) << describe(a);
+    ASSERT_TRUE(b.converged) << describe(b);
+    // Both meet the same natural-map residual in their own form ...
+    EXPECT_LE(a.residual, options.abs_tol + options.rel_tol * a.norm_c) << method_name(method);
+    // ... and the two forms' ξ of the compact solution agree: one problem, two coordinates.
+    std::vector<Vector6> u_K(compact_solution.u.size());
+    for (std::size_t k = 0; k < u_K.size(); ++k) {
+      u_K[k] << compact_solution.u[k].head<3>(),
+          r.A_IK[k].transpose() * compact_solution.u[k].tail<3>();
+    }
+    const std::vector<Vector6> u_from_body_form =
+        velocities_from_percussions(body, compact_solution.lambda);
+    for (std::size_t k = 0; k < u_K.size(); ++k) {
+      EXPECT_LE((u_K[k] - u_from_body_form[k]).norm(), 1e-12) << method_name(method);
+    }
+    std::vector<double> mu;
+    for (const CompactContact& c : r.problem.contacts) mu.push_back(c.mu);
+    const double body_residual =
+        natural_map_residual(compact_solution.lambda, contact_velocities(body, u_K), mu);
+    EXPECT_LE(body_residual, 1e-10 * a.norm_c) << method_name(method);
+  }
+}
+
+TEST(CompactProblem, TheIsotropicSweepIsTheGeneralOneForSpheres) {
+  Random r = random_problem(10, 30, true, 7);
+  validate(r.problem);
+  CompactProblem general = r.problem;
+  general.isotropic = false;
+  std::vector<RFactors> rf;
+  for (const CompactContact& c : r.problem.contacts) {
+    rf.push_back(r_factors(delassus_block(c, r.problem.M_inv), 1.0));
+  }
+  std::vector<Vector6> u1 = r.problem.u_free;
+  std::vector<Vector6> u2 = r.problem.u_free;
+  std::vector<Vector3> l1(r.problem.contacts.size(), Vector3::Zero());
+  std::vector<Vector3> l2 = l1;
+  for (int k = 0; k < 20; ++k) {
+    EXPECT_TRUE(sor_sweep(r.problem, rf, ProxForm::alart_curnier, u1, l1));
+    EXPECT_TRUE(sor_sweep(general, rf, ProxForm::alart_curnier, u2, l2));
+  }
+  for (std::size_t i = 0; i < l1.size(); ++i) EXPECT_LE((l1[i] - l2[i]).norm(), 1e-13);
+  for (std::size_t b = 0; b < u1.size(); ++b) EXPECT_LE((u1[b] - u2[b]).norm(), 1e-13);
+  // A non-isotropic body in a problem marked isotropic is refused.
+  r.problem.M_inv[3].I_Theta_inv(0, 1) = r.problem.M_inv[3].I_Theta_inv(1, 0) = 0.1;
+  EXPECT_THROW(validate(r.problem), InvalidArgument);
+}
+
+TEST(CompactProblem, TheSweepReportsANonFinitePercussionAndTheSolverStopsAsDiverged) {
+  Random r = random_problem(4, 6, false, 9);
+  std::vector<RFactors> rf(r.problem.contacts.size(), RFactors{1.0, 1.0});
+  std::vector<Vector6> u = r.problem.u_free;
+  std::vector<Vector3> lambda(r.problem.contacts.size(), Vector3::Zero());
+  EXPECT_TRUE(sor_sweep(r.problem, rf, ProxForm::alart_curnier, u, lambda));
+  lambda[2](1) = std::numeric_limits<double>::infinity();
+  lambda[2](0) = 1.0;
+  EXPECT_FALSE(sor_sweep(r.problem, rf, ProxForm::alart_curnier, u, lambda));
+  // Masses of 10³⁰⁰ kg (r-factors of 10³⁰⁰ kg) and velocities of 10³⁰⁰ m/s: λ = r ξ overflows in
+  // the first sweep, and SOR stops there, diverged.
+  for (Vector6& v : r.problem.u_free) v *= 1e300;
+  for (WorldInverseMass& M : r.problem.M_inv) {
+    M.inv_m *= 1e-300;
+    M.I_Theta_inv *= 1e-300;
+  }
+  SolverOptions options;
+  options.max_iterations = 50;
+  ContactSolution solution;
+  ContactSolver solver(Method::sor, options);
+  const SolverResult result = solver.solve(r.problem, solution);
+  EXPECT_TRUE(result.diverged);
+  EXPECT_FALSE(result.converged);
+  EXPECT_EQ(result.iterations, 1);
+}
+
+TEST(CompactProblem, ValidationNamesTheBadEntry) {
+  const auto message = [](const CompactProblem& p) {
+    try {
+      validate(p);
+    } catch (const InvalidArgument& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  const Random r = random_problem(3, 4, false, 11);
+  CompactProblem p = r.problem;
+  p.contacts[1].body_b = 7;
+  EXPECT_NE(message(p).find("contact 1: body_b = 7"), std::string::npos) << message(p);
+  p = r.problem;
+  p.contacts[2].n *= 2.0;
+  EXPECT_NE(message(p).find("contact 2: expected a unit normal"), std::string::npos);
+  p = r.problem;
+  p.contacts[0].mu = -0.1;
+  EXPECT_NE(message(p).find("contact 0: expected a finite friction coefficient"),
+            std::string::npos);
+  p = r.problem;
+  p.M_inv[1].inv_m = 0.0;
+  EXPECT_NE(message(p).find("body 1: expected a finite 1/m > 0"), std::string::npos);
+  p = r.problem;
+  p.u_free.pop_back();
+  EXPECT_NE(message(p).find("M_inv has 3 bodies but u_free has 2"), std::string::npos);
+  p = r.problem;
+  p.contacts[3].body_a = p.contacts[3].body_b = kStatic;
+  EXPECT_NE(message(p).find("contact 3: both sides are static"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace grbd::contact
