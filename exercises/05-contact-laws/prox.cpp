@@ -204,6 +204,7 @@ inline void apply_percussion(double s, const WorldInverseMass& M, const Vector3&
   }
 }
 
+// [compact sweep kernel]
 /// The sweep of sor_sweep(const CompactProblem&, …), for general or isotropic inverse inertias.
 template <bool Isotropic>
 [[gnu::flatten]] bool compact_sweep(const CompactProblem& problem, std::span<const RFactors> r,
@@ -261,6 +262,7 @@ template <bool Isotropic>
   }
   return probe == 0.0;
 }
+// [compact sweep kernel]
 
 }  // namespace
 

@@ -30,6 +30,7 @@ using grbd::contact::ContactProblem;
 using grbd::contact::ContactSolution;
 using grbd::contact::ContactSolver;
 using grbd::contact::Criterion;
+using grbd::contact::IterationStatus;
 using grbd::contact::LocalProblem;
 using grbd::contact::Method;
 using grbd::contact::SolverHooks;
@@ -82,9 +83,9 @@ TEST(SolverAllocations, SecondSolveOfTheSameOrSmallerSizeAllocatesNothing) {
       bool verdicts = false;
       SolverHooks hooks;
       hooks.after_iteration = [&calls](int, std::span<Vector3>, std::span<Vector6>) { ++calls; };
-      hooks.global_converged = [&verdicts](bool locally) {
-        verdicts = verdicts || locally;
-        return locally;
+      hooks.global_status = [&verdicts](IterationStatus local) {
+        verdicts = verdicts || local == IterationStatus::converged;
+        return local;
       };
       ContactSolver solver(method, o, hooks);
       ContactSolution solution;

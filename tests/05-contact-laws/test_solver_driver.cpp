@@ -42,6 +42,8 @@ using grbd::contact::ContactProblem;
 using grbd::contact::ContactSolution;
 using grbd::contact::ContactSolver;
 using grbd::contact::Criterion;
+using grbd::contact::InverseMass;
+using grbd::contact::IterationStatus;
 using grbd::contact::LocalProblem;
 using grbd::contact::Method;
 using grbd::contact::ProxForm;
@@ -228,7 +230,7 @@ TEST(SolverDriver, AfterIterationIsCalledOncePerIterationWithCurrentVelocities) 
   }
 }
 
-// Reference: the declaration of SolverHooks::global_converged: it is asked once per iteration
+// Reference: the declaration of SolverHooks::global_status: it is asked once per iteration
 // and its answer is the verdict. Answering false keeps every method going to max_iterations and
 // reports non-convergence, although the local verdict was true (the hook saw it); answering true
 // stops at once. Every method, every criterion, both forms.
@@ -248,10 +250,10 @@ TEST(SolverDriver, GlobalVerdictOverridesTheLocalOne) {
       int asked = 0;
       int locally_true = 0;
       SolverHooks never;
-      never.global_converged = [&](bool locally) {
+      never.global_status = [&](IterationStatus local) {
         ++asked;
-        locally_true += locally ? 1 : 0;
-        return false;
+        locally_true += local == IterationStatus::converged ? 1 : 0;
+        return IterationStatus::running;
       };
       ContactSolution solution;
       const SolverResult result = ContactSolver(method, o, never).solve(problem, solution);
@@ -270,12 +272,64 @@ TEST(SolverDriver, GlobalVerdictOverridesTheLocalOne) {
       EXPECT_EQ(asked, o.max_iterations);
 
       SolverHooks always;
-      always.global_converged = [](bool) { return true; };
+      always.global_status = [](IterationStatus) { return IterationStatus::converged; };
       ContactSolution stopped;
       const SolverResult first = ContactSolver(method, o, always).solve(problem, stopped);
       EXPECT_TRUE(first.converged);
       EXPECT_EQ(first.iterations, 1);
     }
+  }
+}
+
+// Reference: the declaration of SolverHooks::global_status, the contract chapter 8's MPI reduction
+// relies on. A divergence elsewhere (the hook answers diverged) stops every method at once as
+// diverged; a local divergence is still reported to the hook, once, in the iteration where it
+// happens, so that the other processes are not left waiting in their reduction; an answer
+// outside the enumerators is refused.
+TEST(SolverDriver, DivergenceIsPartOfTheGlobalVerdict) {
+  const ContactProblem problem = small_problem();
+  for (const Method method : kAllMethods) {
+    SCOPED_TRACE(name(method));
+    SolverOptions o = quick(method, Criterion::percussion_change);
+    o.max_iterations = 500;
+    std::vector<IterationStatus> seen;
+    SolverHooks remote;
+    remote.global_status = [&](IterationStatus local) {
+      seen.push_back(local);
+      return seen.size() == 3 ? IterationStatus::diverged : IterationStatus::running;
+    };
+    ContactSolution solution;
+    const SolverResult result = ContactSolver(method, o, remote).solve(problem, solution);
+    EXPECT_TRUE(result.diverged);
+    EXPECT_FALSE(result.converged);
+    EXPECT_EQ(result.iterations, 3);
+    ASSERT_EQ(seen.size(), 3u);
+    EXPECT_NE(seen[2], IterationStatus::diverged);  // this process was fine
+
+    // A local divergence: masses of 10³⁰⁰ kg and velocities of 10³⁰⁰ m/s overflow λ at once.
+    ContactProblem huge = problem;
+    for (InverseMass& M : huge.M_inv) {
+      M.inv_m *= 1e-300;
+      M.K_Theta_inv *= 1e-300;
+    }
+    for (Vector6& u : huge.u_free) u *= 1e300;
+    seen.clear();
+    SolverHooks reporting;
+    reporting.global_status = [&](IterationStatus local) {
+      seen.push_back(local);
+      return local;
+    };
+    ContactSolution blown;
+    const SolverResult local = ContactSolver(method, o, reporting).solve(huge, blown);
+    EXPECT_TRUE(local.diverged) << grbd::contact::describe(local);
+    ASSERT_FALSE(seen.empty());
+    EXPECT_EQ(seen.back(), IterationStatus::diverged);
+    EXPECT_EQ(static_cast<int>(seen.size()), local.iterations);
+
+    SolverHooks broken;
+    broken.global_status = [](IterationStatus) { return static_cast<IterationStatus>(7); };
+    ContactSolution unused;
+    EXPECT_THROW(ContactSolver(method, o, broken).solve(problem, unused), grbd::InvalidArgument);
   }
 }
 

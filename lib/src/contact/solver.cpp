@@ -810,10 +810,24 @@ void iterate(Model& model, Policy& policy, Monitor<Model>& monitor, const Solver
       model.touched();
     }
     const Verdict verdict = monitor.after(k);
-    if (verdict == Verdict::diverged) break;
-    const bool local = verdict == Verdict::met && policy.accept(k);
-    const bool global = hooks.global_converged ? hooks.global_converged(local) : local;
-    if (global) {
+    IterationStatus local = IterationStatus::running;
+    if (verdict == Verdict::diverged) {
+      local = IterationStatus::diverged;
+    } else if (verdict == Verdict::met && policy.accept(k)) {
+      local = IterationStatus::converged;
+    }
+    const IterationStatus global = hooks.global_status ? hooks.global_status(local) : local;
+    if (global != IterationStatus::converged && global != IterationStatus::running &&
+        global != IterationStatus::diverged) {
+      throw InvalidArgument("SolverHooks::global_status returned " +
+                            std::to_string(static_cast<int>(global)) +
+                            ", not one of converged (0), running (1), diverged (2)");
+    }
+    if (global == IterationStatus::diverged) {
+      result.diverged = true;  // here or on another process
+      break;
+    }
+    if (global == IterationStatus::converged) {
       result.converged = true;
       break;
     }

@@ -198,8 +198,15 @@ void ContactDetector::detect(const BodySystem& system, const StaticGeometry& sta
     const bool bounded = kind != collision::ShapeKind::half_space &&
                          kind != collision::ShapeKind::mesh;
     const double r_s = bounded ? collision::bounding_radius(objects[s].shape) : 0.0;
+    const auto* half_space = std::get_if<collision::HalfSpace>(&objects[s].shape);
     for (std::size_t i = 0; i < n; ++i) {
       if (!system.dynamic(i)) continue;
+      // A half-space (frame I) is skipped by the height of the bounding sphere above it: most
+      // bodies of a pile are far from most walls, and the test costs one dot product.
+      if (half_space != nullptr &&
+          half_space->I_n.dot(placements_[i].I_r) - half_space->offset - radii[i] > margin) {
+        continue;
+      }
       if (bounded) {
         const double reach = radii[i] + r_s + margin;
         if ((placements_[i].I_r - objects[s].pose.I_r).squaredNorm() > reach * reach) continue;

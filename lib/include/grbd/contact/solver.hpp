@@ -7,7 +7,7 @@
 ///
 /// The three methods share one driver: every iteration is "remember what the stopping test
 /// compares; one iteration of the method; the hook SolverHooks::after_iteration; the stopping
-/// test, turned into a global verdict by SolverHooks::global_converged; stop at max_iterations".
+/// test, turned into a global verdict by SolverHooks::global_status; stop at max_iterations".
 /// ContactSolver keeps the buffers of that loop between solves (a time stepper calls it once per
 /// step without allocating); the free functions solve_sor(), solve_jor() and solve_apgd() are
 /// one-shot wrappers around it.
@@ -191,6 +191,14 @@ void sor_sweep(const ContactProblem& problem, std::span<const RFactors> r, ProxF
                std::span<Vector6> u, std::span<Vector3> lambda);
 // [sor sweep declaration]
 
+/// The status of a solver after one iteration, ordered so that the global status of several
+/// processes is the largest of theirs.
+enum class IterationStatus : int {
+  converged = 0,  ///< the stopping test is met
+  running = 1,    ///< not yet: iterate on
+  diverged = 2,   ///< an iterate is not finite: stop
+};
+
 /// Where a distributed solver (chapter 8) plugs into the iteration of every method: split-body
 /// averaging after each sweep, and a global convergence verdict. Empty members are not called.
 struct SolverHooks {
@@ -201,12 +209,16 @@ struct SolverHooks {
   /// test; JOR and APGD recompute u from Λ (and do so once more at the end), so for them only
   /// changes to Λ count, and APGD's own buffers (momentum, ξ) do not follow such a change.
   std::function<void(int k, std::span<Vector3> lambda, std::span<Vector6> u)> after_iteration;
-  /// Turns this process's verdict of the stopping test (criterion met and k ≥ min_iterations; for
-  /// APGD also its cone offset consistent) into the global one: with MPI a logical AND over the
-  /// ranks. Called once in every iteration, so that a collective reduction stays matched across
-  /// processes, except in the iteration where an iterate turns out not finite: that process stops
-  /// at once (diverged) without calling it. `converged` is the value it returns.
-  std::function<bool(bool locally_converged)> global_converged;
+  /// Turns this process's status after an iteration into the global one: with MPI the maximum
+  /// over the ranks (MPI_Allreduce with MPI_MAX on the integer values of IterationStatus), so
+  /// that every process stops as diverged when one of them diverged, and as converged only when
+  /// all of them converged. Called exactly once in every iteration, a divergence included, so that
+  /// the collective reduction stays matched across processes: a rank whose iterate is not finite
+  /// does not leave the others waiting in their reduction. Locally, `converged` means the
+  /// criterion met and k ≥ min_iterations (for APGD also its cone offset consistent), `diverged`
+  /// a non-finite iterate. The solver follows what the hook returns; a global `diverged` sets
+  /// SolverResult::diverged on every process.
+  std::function<IterationStatus(IterationStatus local)> global_status;
 };
 
 namespace detail {
