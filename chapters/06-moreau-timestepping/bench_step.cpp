@@ -71,15 +71,21 @@ void BM_step(benchmark::State& state) {
   const double steps = static_cast<double>(state.iterations());
   const double bytes = heap_in_use() - heap_before;
 
-  // The floor: 100 bare sweeps over the same problem, in the same run, from Λ = 0. Beside it,
-  // chapter 5's sweep over the same problem in body form (two 6 × 3 Jacobians per contact).
+  // The floor: 100 bare sweeps over the problem of one more step, in the same run, from the warm
+  // start that step's solve began with (the previous step's percussions, looked up by key) and
+  // the velocities that go with them. Beside it, chapter 5's sweep over the same problem in body
+  // form (two 6 × 3 Jacobians per contact, contact::body_form), from the same state.
+  const timestep::WarmStartTable previous = stepper.warm_starts();
+  stepper.step();
   const contact::CompactProblem& problem = stepper.problem();
+  std::vector<Vector3> lambda0(problem.contacts.size());
+  previous.initialize(stepper.keys(), lambda0);
   std::vector<contact::RFactors> r(problem.contacts.size());
   for (std::size_t i = 0; i < r.size(); ++i) {
     r[i] = contact::r_factors(contact::delassus_block(problem.contacts[i], problem.M_inv), 1.0);
   }
   const auto time_sweeps = [&](const auto& p, std::vector<Vector6> u) {
-    std::vector<Vector3> lambda(p.contacts.size(), Vector3::Zero());
+    std::vector<Vector3> lambda = lambda0;
     const auto t0 = std::chrono::steady_clock::now();
     for (int k = 0; k < 100; ++k) {
       contact::sor_sweep(p, r, contact::ProxForm::alart_curnier, u, lambda);
@@ -87,13 +93,27 @@ void BM_step(benchmark::State& state) {
     benchmark::DoNotOptimize(lambda.data());
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   };
-  const double sweeps = time_sweeps(problem, problem.u_free);
+  std::vector<Vector6> u0 = problem.u_free;  // u_free + M⁻¹ W Λ₀, frame I
+  for (std::size_t i = 0; i < problem.contacts.size(); ++i) {
+    const contact::CompactContact& c = problem.contacts[i];
+    const auto add = [&](collision::BodyIndex b, const Vector3& lever, double sign) {
+      if (b == collision::kStatic) return;
+      const contact::WorldInverseMass& M = problem.M_inv[static_cast<std::size_t>(b)];
+      const Vector6 p = contact::side_percussion(c, lever, lambda0[i]);
+      u0[static_cast<std::size_t>(b)].head<3>() += sign * M.inv_m * p.head<3>();
+      u0[static_cast<std::size_t>(b)].tail<3>() += sign * (M.I_Theta_inv * p.tail<3>());
+    };
+    add(c.body_a, c.r_a, 1.0);
+    add(c.body_b, c.r_b, -1.0);
+  }
+  const double sweeps = time_sweeps(problem, u0);
   std::vector<Matrix3> A_IK(system.size());
   for (std::size_t i = 0; i < A_IK.size(); ++i) {
     A_IK[i] = kinematics::rotation_matrix(kinematics::orientation(system.states()[i].q));
   }
   const contact::ContactProblem body = contact::body_form(problem, system.M_inv(), A_IK);
-  const double body_sweeps = time_sweeps(body, body.u_free);
+  const double body_sweeps =
+      time_sweeps(body, contact::velocities_from_percussions(body, lambda0));
 
   const auto N = static_cast<double>(system.size());
   state.counters["spheres"] = N;
