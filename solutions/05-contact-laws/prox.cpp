@@ -153,39 +153,56 @@ Vector3 sor_contact_update(const ContactConstraint& c, const RFactors& r, ProxFo
 // The sweep lives in this file, next to the update it repeats, so that the compiler can inline
 // the update into the loop: `flatten` makes sure it does (on its own GCC keeps the call, and
 // with it the arguments passed through memory).
+namespace {
+
+/// The O(1) check of a sweep's arguments: one r-factor and one percussion per contact, one
+/// velocity per body.
+void require_sweep_sizes(std::size_t contacts, std::size_t bodies, std::size_t r,
+                         std::size_t lambda, std::size_t u) {
+  if (r != contacts || lambda != contacts || u != bodies) {
+    throw InvalidArgument("sor_sweep: expected " + std::to_string(contacts) + " r-factors and " +
+                          std::to_string(contacts) + " percussions (one per contact) and " +
+                          std::to_string(bodies) + " velocities (one per body); found " +
+                          std::to_string(r) + ", " + std::to_string(lambda) + " and " +
+                          std::to_string(u));
+  }
+}
+
+/// Software prefetch for piles that do not fit in the caches: the contact `ahead` places ahead
+/// of contact i (all its cache lines), and the velocity and inverse mass of body b of the contact
+/// ahead / 2 places ahead, whose index is read from a line prefetched before. Body a advances
+/// steadily through the Morton order and is left to the hardware prefetcher, as are r and λ.
+template <class Contact, class Mass>
+inline void prefetch_ahead(const Contact* contacts, std::size_t i, std::size_t n,
+                           std::size_t ahead, const Vector6* u, const Mass* M_inv) {
+  if (i + ahead < n) {
+    const char* next = reinterpret_cast<const char*>(contacts + i + ahead);
+    for (std::size_t k = 0; k < sizeof(Contact); k += 64) __builtin_prefetch(next + k);
+    __builtin_prefetch(next + sizeof(Contact) - 1);
+  }
+  if (i + ahead / 2 < n) {
+    const BodyIndex b = contacts[i + ahead / 2].body_b;
+    if (b != kStatic) {
+      __builtin_prefetch(&u[b], 1);
+      __builtin_prefetch(reinterpret_cast<const char*>(&u[b] + 1) - 1, 1);
+      __builtin_prefetch(&M_inv[b]);
+    }
+  }
+}
+
+}  // namespace
+
 // [sor sweep]
 [[gnu::flatten]] void sor_sweep(const ContactProblem& problem, std::span<const RFactors> r,
                                 ProxForm form, std::span<Vector6> u, std::span<Vector3> lambda) {
   const std::size_t n = problem.contacts.size();
-  if (r.size() != n || lambda.size() != n || u.size() != problem.M_inv.size()) {
-    throw InvalidArgument("sor_sweep: expected " + std::to_string(n) + " r-factors and " +
-                          std::to_string(n) + " percussions (one per contact) and " +
-                          std::to_string(problem.M_inv.size()) + " velocities (one per body); "
-                          "found " + std::to_string(r.size()) + ", " +
-                          std::to_string(lambda.size()) + " and " + std::to_string(u.size()));
-  }
+  require_sweep_sizes(n, problem.M_inv.size(), r.size(), lambda.size(), u.size());
   const ContactConstraint* contacts = problem.contacts.data();
   const std::span<const InverseMass> M_inv(problem.M_inv);
-  // Software prefetch for piles that do not fit in the caches: the contact kAhead places ahead
-  // (352 bytes, six cache lines), and the velocity and inverse mass of body b of the contact
-  // kAhead / 2 places ahead, whose index is read from a line prefetched before. Body a advances
-  // steadily through the Morton order and is left to the hardware prefetcher, as are r and λ.
-  // The contacts are still updated one after the other in the order 0 … n − 1.
-  constexpr std::size_t kAhead = 32;
+  // The contacts are updated one after the other in the order 0 … n − 1; the prefetch looks 32
+  // contacts (352 bytes, six cache lines each) ahead.
   for (std::size_t i = 0; i < n; ++i) {
-    if (i + kAhead < n) {
-      const char* next = reinterpret_cast<const char*>(contacts + i + kAhead);
-      for (std::size_t k = 0; k < sizeof(ContactConstraint); k += 64) __builtin_prefetch(next + k);
-      __builtin_prefetch(next + sizeof(ContactConstraint) - 1);
-    }
-    if (i + kAhead / 2 < n) {
-      const BodyIndex b = contacts[i + kAhead / 2].body_b;
-      if (b != kStatic) {
-        __builtin_prefetch(&u[b], 1);
-        __builtin_prefetch(reinterpret_cast<const char*>(&u[b] + 1) - 1, 1);
-        __builtin_prefetch(&M_inv[b]);
-      }
-    }
+    prefetch_ahead(contacts, i, n, 32, u.data(), M_inv.data());
     sor_contact_update(contacts[i], r[i], form, M_inv, u, lambda[i]);
   }
 }
@@ -238,24 +255,8 @@ template <bool Isotropic>
   const WorldInverseMass* M_inv = problem.M_inv.data();
   Vector6* U = u.data();
   double probe = 0.0;  // 0 · λ summed: stays 0 while every λ is finite
-  // Prefetch as chapter 5's sweep does: the contact kAhead places ahead (136 bytes, three cache
-  // lines) and body b of the contact kAhead / 2 places ahead.
-  constexpr std::size_t kAhead = 16;
   for (std::size_t i = 0; i < n; ++i) {
-    if (i + kAhead < n) {
-      const char* next = reinterpret_cast<const char*>(contacts + i + kAhead);
-      __builtin_prefetch(next);
-      __builtin_prefetch(next + 64);
-      __builtin_prefetch(next + sizeof(CompactContact) - 1);
-    }
-    if (i + kAhead / 2 < n) {
-      const BodyIndex b = contacts[i + kAhead / 2].body_b;
-      if (b != kStatic) {
-        __builtin_prefetch(&U[b], 1);
-        __builtin_prefetch(reinterpret_cast<const char*>(&U[b] + 1) - 1, 1);
-        __builtin_prefetch(&M_inv[b]);
-      }
-    }
+    prefetch_ahead(contacts, i, n, 16, U, M_inv);  // 136-byte records: 16 ahead
     const CompactContact& c = contacts[i];
     const Vector3 t2 = c.t2();
     // γ = Fᵀ(v_a + ω_a × r_a − v_b − ω_b × r_b), then ξ = γ + ε ∘ γ_A.
@@ -292,14 +293,8 @@ template <bool Isotropic>
 // [compact sweep]
 bool sor_sweep(const CompactProblem& problem, std::span<const RFactors> r, ProxForm form,
                std::span<Vector6> u, std::span<Vector3> lambda) {
-  const std::size_t n = problem.contacts.size();
-  if (r.size() != n || lambda.size() != n || u.size() != problem.M_inv.size()) {
-    throw InvalidArgument("sor_sweep: expected " + std::to_string(n) + " r-factors and " +
-                          std::to_string(n) + " percussions (one per contact) and " +
-                          std::to_string(problem.M_inv.size()) + " velocities (one per body); "
-                          "found " + std::to_string(r.size()) + ", " +
-                          std::to_string(lambda.size()) + " and " + std::to_string(u.size()));
-  }
+  require_sweep_sizes(problem.contacts.size(), problem.M_inv.size(), r.size(), lambda.size(),
+                      u.size());
   return problem.isotropic ? compact_sweep<true>(problem, r, form, u, lambda)
                            : compact_sweep<false>(problem, r, form, u, lambda);
 }
