@@ -93,19 +93,8 @@ void BM_step(benchmark::State& state) {
     benchmark::DoNotOptimize(lambda.data());
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   };
-  std::vector<Vector6> u0 = problem.u_free;  // u_free + M⁻¹ W Λ₀, frame I
-  for (std::size_t i = 0; i < problem.contacts.size(); ++i) {
-    const contact::CompactContact& c = problem.contacts[i];
-    const auto add = [&](collision::BodyIndex b, const Vector3& lever, double sign) {
-      if (b == collision::kStatic) return;
-      const contact::WorldInverseMass& M = problem.M_inv[static_cast<std::size_t>(b)];
-      const Vector6 p = contact::side_percussion(c, lever, lambda0[i]);
-      u0[static_cast<std::size_t>(b)].head<3>() += sign * M.inv_m * p.head<3>();
-      u0[static_cast<std::size_t>(b)].tail<3>() += sign * (M.I_Theta_inv * p.tail<3>());
-    };
-    add(c.body_a, c.r_a, 1.0);
-    add(c.body_b, c.r_b, -1.0);
-  }
+  std::vector<Vector6> u0;  // u_free + M⁻¹ W Λ₀, frame I
+  contact::velocities_from_percussions(problem, lambda0, u0);
   const double sweeps = time_sweeps(problem, u0);
   std::vector<Matrix3> A_IK(system.size());
   for (std::size_t i = 0; i < A_IK.size(); ++i) {

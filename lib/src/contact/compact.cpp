@@ -129,6 +129,28 @@ Vector6 side_percussion(const CompactContact& c, const Vector3& r_side, const Ve
   return out;
 }
 
+void add_percussion(const CompactContact& c, const Vector3& lambda,
+                    std::span<const WorldInverseMass> M_inv, std::span<Vector6> v) {
+  const auto apply = [&](BodyIndex body, const Vector3& r, double sign) {
+    if (body == kStatic) return;
+    const WorldInverseMass& M = M_inv[static_cast<std::size_t>(body)];
+    const Vector6 p = side_percussion(c, r, lambda);
+    Vector6& vb = v[static_cast<std::size_t>(body)];
+    vb.head<3>() += sign * M.inv_m * p.head<3>();
+    vb.tail<3>() += sign * (M.I_Theta_inv * p.tail<3>());
+  };
+  apply(c.body_a, c.r_a, 1.0);
+  apply(c.body_b, c.r_b, -1.0);
+}
+
+void velocities_from_percussions(const CompactProblem& problem, std::span<const Vector3> lambda,
+                                 std::vector<Vector6>& u) {
+  u.assign(problem.u_free.begin(), problem.u_free.end());
+  for (std::size_t i = 0; i < lambda.size(); ++i) {
+    add_percussion(problem.contacts[i], lambda[i], problem.M_inv, u);
+  }
+}
+
 ContactProblem body_form(const CompactProblem& problem, std::span<const InverseMass> M_inv,
                          std::span<const Matrix3> A_IK) {
   const std::size_t n = problem.M_inv.size();

@@ -365,7 +365,9 @@ class CompactModel {
   void apply_G(std::span<const Vector3> x, std::vector<Vector3>& y) {
     std::vector<Vector6>& v = ws_.v;
     v.assign(problem_.M_inv.size(), Vector6::Zero());
-    for (std::size_t i = 0; i < size(); ++i) add_percussion(problem_.contacts[i], x[i], v);
+    for (std::size_t i = 0; i < size(); ++i) {
+      add_percussion(problem_.contacts[i], x[i], problem_.M_inv, v);
+    }
     y.resize(size());
     for (std::size_t i = 0; i < size(); ++i) y[i] = contact_velocity(problem_.contacts[i], v);
   }
@@ -392,23 +394,8 @@ class CompactModel {
   void touched() { sweep_fresh_ = false; }
 
  private:
-  /// v_s ± M_s⁻¹ W_s λ for both sides.
-  void add_percussion(const CompactContact& c, const Vector3& lambda,
-                      std::vector<Vector6>& v) const {
-    const auto apply = [&](BodyIndex body, const Vector3& r, double sign) {
-      if (body == kStatic) return;
-      const WorldInverseMass& M = problem_.M_inv[static_cast<std::size_t>(body)];
-      const Vector6 p = side_percussion(c, r, lambda);
-      Vector6& vb = v[static_cast<std::size_t>(body)];
-      vb.head<3>() += sign * M.inv_m * p.head<3>();
-      vb.tail<3>() += sign * (M.I_Theta_inv * p.tail<3>());
-    };
-    apply(c.body_a, c.r_a, 1.0);
-    apply(c.body_b, c.r_b, -1.0);
-  }
   void body_velocities(std::span<const Vector3> lambda, std::vector<Vector6>& u) const {
-    u.assign(problem_.u_free.begin(), problem_.u_free.end());
-    for (std::size_t i = 0; i < lambda.size(); ++i) add_percussion(problem_.contacts[i], lambda[i], u);
+    velocities_from_percussions(problem_, lambda, u);
   }
   void contact_velocities_of(std::span<const Vector6> u, std::vector<Vector3>& xi) const {
     xi.resize(size());

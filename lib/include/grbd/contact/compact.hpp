@@ -75,6 +75,17 @@ Vector3 contact_velocity(const CompactContact& contact, std::span<const Vector6>
 /// The generalised percussion W_s λ of side s of a compact contact: (F λ, r_s × F λ), frame I.
 Vector6 side_percussion(const CompactContact& contact, const Vector3& r_side, const Vector3& lambda);
 
+/// v_a += M_a⁻¹ W_a λ and v_b −= M_b⁻¹ W_b λ for the percussion λ of one compact contact (static
+/// sides skipped): what a percussion does to the world-frame body velocities v.
+void add_percussion(const CompactContact& contact, const Vector3& lambda,
+                    std::span<const WorldInverseMass> M_inv, std::span<Vector6> v);
+
+/// u = u_free + M⁻¹ W Λ for percussions Λ (one per contact), into `u` (resized to one entry per
+/// body, its capacity reused). The indices of the contacts are not checked: `problem` must be one
+/// that validate() accepted.
+void velocities_from_percussions(const CompactProblem& problem, std::span<const Vector3> lambda,
+                                 std::vector<Vector6>& u);
+
 /// The same problem in the body form of chapter 5, for bodies with principal-frame inverse masses
 /// `M_inv` and orientations `A_IK` (those the compact problem was built with, one per body):
 /// W_s = [F; A_IKᵀ (r_s × F)], u_free with ω in frame K, γ_A = xi_A with ε_N = ε_T = 1. The
