@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "grbd/contact/compact.hpp"
+#include "grbd/contact/detail/compact_kernels.hpp"
 #include "grbd/contact/problem.hpp"
 #include "grbd/contact/prox.hpp"
 #include "grbd/contact/solver.hpp"
@@ -212,49 +213,22 @@ inline void prefetch_ahead(const Contact* contacts, std::size_t i, std::size_t n
 // repeats are inlined into its loop.
 namespace {
 
-/// w += s (v + ω × r) for a body velocity u = (v, ω), written component by component.
-inline void add_point_velocity(double s, const double* u, const Vector3& r, double* w) {
-  w[0] += s * (u[0] + (u[4] * r(2) - u[5] * r(1)));
-  w[1] += s * (u[1] + (u[5] * r(0) - u[3] * r(2)));
-  w[2] += s * (u[2] + (u[3] * r(1) - u[4] * r(0)));
-}
-
-/// u += s M⁻¹ (P, r × P) for the world percussion P at lever arm r; with `Isotropic` the inverse
-/// inertia is its (0, 0) entry times I₃.
-template <bool Isotropic>
-inline void apply_percussion(double s, const WorldInverseMass& M, const Vector3& r,
-                             const double* P, double* u) {
-  const double sm = s * M.inv_m;
-  u[0] += sm * P[0];
-  u[1] += sm * P[1];
-  u[2] += sm * P[2];
-  const double L0 = r(1) * P[2] - r(2) * P[1];
-  const double L1 = r(2) * P[0] - r(0) * P[2];
-  const double L2 = r(0) * P[1] - r(1) * P[0];
-  const Matrix3& T = M.I_Theta_inv;
-  if constexpr (Isotropic) {
-    const double st = s * T(0, 0);
-    u[3] += st * L0;
-    u[4] += st * L1;
-    u[5] += st * L2;
-  } else {
-    u[3] += s * (T(0, 0) * L0 + T(0, 1) * L1 + T(0, 2) * L2);
-    u[4] += s * (T(1, 0) * L0 + T(1, 1) * L1 + T(1, 2) * L2);
-    u[5] += s * (T(2, 0) * L0 + T(2, 1) * L1 + T(2, 2) * L2);
-  }
-}
+using detail::add_point_velocity;
+using detail::apply_percussion;
 
 // [compact sweep kernel]
 /// The sweep of sor_sweep(const CompactProblem&, …), for general or isotropic inverse inertias.
 template <bool Isotropic>
-[[gnu::flatten]] bool compact_sweep(const CompactProblem& problem, std::span<const RFactors> r,
-                                    ProxForm form, std::span<Vector6> u,
-                                    std::span<Vector3> lambda) {
+[[gnu::flatten]] SweepReport compact_sweep(const CompactProblem& problem,
+                                           std::span<const RFactors> r, ProxForm form,
+                                           std::span<Vector6> u, std::span<Vector3> lambda,
+                                           double abs_tol, double rel_tol) {
   const std::size_t n = problem.contacts.size();
   const CompactContact* contacts = problem.contacts.data();
   const WorldInverseMass* M_inv = problem.M_inv.data();
   Vector6* U = u.data();
-  double probe = 0.0;  // 0 · λ summed: stays 0 while every λ is finite
+  double probe = 0.0;     // 0 · λ summed: stays 0 while every λ is finite
+  bool unsettled = false;  // some |Δλ_k| > abs_tol + rel_tol |λ_k| (or NaN)
   for (std::size_t i = 0; i < n; ++i) {
     prefetch_ahead(contacts, i, n, 16, U, M_inv);  // 136-byte records: 16 ahead
     const CompactContact& c = contacts[i];
@@ -273,6 +247,9 @@ template <bool Isotropic>
     const Vector3 delta = updated - l;
     l = updated;
     probe += 0.0 * updated(0) + 0.0 * updated(1) + 0.0 * updated(2);
+    for (int k = 0; k < 3; ++k) {
+      unsettled |= !(std::abs(delta(k)) <= abs_tol + rel_tol * std::abs(updated(k)));
+    }
     if (delta.isZero(0.0)) continue;  // Δλ = 0 exactly: the velocities stay as they are
     const double P[3] = {c.n(0) * delta(0) + c.t1(0) * delta(1) + t2(0) * delta(2),
                          c.n(1) * delta(0) + c.t1(1) * delta(1) + t2(1) * delta(2),
@@ -284,19 +261,21 @@ template <bool Isotropic>
       apply_percussion<Isotropic>(-1.0, M_inv[c.body_b], c.r_b, P, U[c.body_b].data());
     }
   }
-  return probe == 0.0;
+  return {probe == 0.0, !unsettled};
 }
 // [compact sweep kernel]
 
 }  // namespace
 
 // [compact sweep]
-bool sor_sweep(const CompactProblem& problem, std::span<const RFactors> r, ProxForm form,
-               std::span<Vector6> u, std::span<Vector3> lambda) {
+SweepReport sor_sweep(const CompactProblem& problem, std::span<const RFactors> r, ProxForm form,
+                      std::span<Vector6> u, std::span<Vector3> lambda, double abs_tol,
+                      double rel_tol) {
   require_sweep_sizes(problem.contacts.size(), problem.M_inv.size(), r.size(), lambda.size(),
                       u.size());
-  return problem.isotropic ? compact_sweep<true>(problem, r, form, u, lambda)
-                           : compact_sweep<false>(problem, r, form, u, lambda);
+  return problem.isotropic
+             ? compact_sweep<true>(problem, r, form, u, lambda, abs_tol, rel_tol)
+             : compact_sweep<false>(problem, r, form, u, lambda, abs_tol, rel_tol);
 }
 // [compact sweep]
 

@@ -26,7 +26,7 @@ namespace {
 /// `isotropic`), random orientations, velocities and contacts, some against the static world.
 struct Random {
   CompactProblem problem;
-  std::vector<InverseMass> M_inv;   // principal frame
+  std::vector<InverseMass> M_inv;  // principal frame
   std::vector<Matrix3> A_IK;
 };
 
@@ -89,6 +89,7 @@ TEST(CompactProblem, HasTheContactVelocitiesAndDelassusBlocksOfTheBodyForm) {
     const Matrix3 G_body = delassus_block(body.contacts[i], body.M_inv);
     EXPECT_LE((G - G_body).norm(), 1e-13 * G_body.norm()) << "contact " << i;
     EXPECT_LE((G - G.transpose()).norm(), 1e-15 * G.norm());
+    EXPECT_LE((delassus_diagonal(c, r.problem.M_inv) - G.diagonal()).norm(), 1e-14 * G.norm());
   }
 }
 
@@ -144,8 +145,8 @@ TEST(CompactProblem, TheIsotropicSweepIsTheGeneralOneForSpheres) {
   std::vector<Vector3> l1(r.problem.contacts.size(), Vector3::Zero());
   std::vector<Vector3> l2 = l1;
   for (int k = 0; k < 20; ++k) {
-    EXPECT_TRUE(sor_sweep(r.problem, rf, ProxForm::alart_curnier, u1, l1));
-    EXPECT_TRUE(sor_sweep(general, rf, ProxForm::alart_curnier, u2, l2));
+    EXPECT_TRUE(sor_sweep(r.problem, rf, ProxForm::alart_curnier, u1, l1).finite);
+    EXPECT_TRUE(sor_sweep(general, rf, ProxForm::alart_curnier, u2, l2).finite);
   }
   for (std::size_t i = 0; i < l1.size(); ++i) EXPECT_LE((l1[i] - l2[i]).norm(), 1e-13);
   for (std::size_t b = 0; b < u1.size(); ++b) EXPECT_LE((u1[b] - u2[b]).norm(), 1e-13);
@@ -159,10 +160,12 @@ TEST(CompactProblem, TheSweepReportsANonFinitePercussionAndTheSolverStopsAsDiver
   std::vector<RFactors> rf(r.problem.contacts.size(), RFactors{1.0, 1.0});
   std::vector<Vector6> u = r.problem.u_free;
   std::vector<Vector3> lambda(r.problem.contacts.size(), Vector3::Zero());
-  EXPECT_TRUE(sor_sweep(r.problem, rf, ProxForm::alart_curnier, u, lambda));
+  EXPECT_TRUE(sor_sweep(r.problem, rf, ProxForm::alart_curnier, u, lambda).finite);
   lambda[2](1) = std::numeric_limits<double>::infinity();
   lambda[2](0) = 1.0;
-  EXPECT_FALSE(sor_sweep(r.problem, rf, ProxForm::alart_curnier, u, lambda));
+  const SweepReport report = sor_sweep(r.problem, rf, ProxForm::alart_curnier, u, lambda);
+  EXPECT_FALSE(report.finite);
+  EXPECT_FALSE(report.settled);  // a NaN change never counts as settled
   // Masses of 10³⁰⁰ kg (r-factors of 10³⁰⁰ kg) and velocities of 10³⁰⁰ m/s: λ = r ξ overflows in
   // the first sweep, and SOR stops there, diverged.
   for (Vector6& v : r.problem.u_free) v *= 1e300;
@@ -178,6 +181,87 @@ TEST(CompactProblem, TheSweepReportsANonFinitePercussionAndTheSolverStopsAsDiver
   EXPECT_TRUE(result.diverged);
   EXPECT_FALSE(result.converged);
   EXPECT_EQ(result.iterations, 1);
+}
+
+// The sweep's own percussion test is has_converged() (chapter 5) of Λ before and after it, sweep
+// by sweep, through the run from Λ = 0 to convergence; the solver that relies on it takes the
+// same iterations and returns bit-identical percussions as the one that keeps a copy of Λ (a
+// hook forces the copy).
+TEST(CompactProblem, TheSweepAppliesThePercussionCriterionToItsOwnChange) {
+  const Random r = random_problem(8, 24, false, 13);
+  std::vector<RFactors> rf;
+  for (const CompactContact& c : r.problem.contacts) {
+    rf.push_back(r_factors(delassus_block(c, r.problem.M_inv), 1.0));
+  }
+  const double abs_tol = 1e-9;
+  const double rel_tol = 1e-6;
+  std::vector<Vector6> u = r.problem.u_free;
+  std::vector<Vector3> lambda(r.problem.contacts.size(), Vector3::Zero());
+  int settled = 0;
+  int unsettled = 0;
+  for (int k = 0; k < 400; ++k) {
+    const std::vector<Vector3> before = lambda;
+    const SweepReport report =
+        sor_sweep(r.problem, rf, ProxForm::alart_curnier, u, lambda, abs_tol, rel_tol);
+    const bool expected = has_converged(
+        std::span<const double>(before.data()->data(), 3 * before.size()),
+        std::span<const double>(lambda.data()->data(), 3 * lambda.size()), abs_tol, rel_tol);
+    ASSERT_EQ(report.settled, expected) << "sweep " << k;
+    (report.settled ? settled : unsettled) += 1;
+  }
+  EXPECT_GT(settled, 0);
+  EXPECT_GT(unsettled, 0);
+
+  SolverOptions options;
+  options.abs_tol = abs_tol;
+  options.rel_tol = rel_tol;
+  options.max_iterations = 10000;
+  options.criterion = Criterion::percussion_change;
+  ContactSolution in_sweep;
+  ContactSolution copied;
+  ContactSolver plain(Method::sor, options);
+  SolverHooks hooks;
+  hooks.after_iteration = [](int, std::span<Vector3>, std::span<Vector6>) {};
+  ContactSolver hooked(Method::sor, options, hooks);
+  const SolverResult a = plain.solve(r.problem, in_sweep);
+  const SolverResult b = hooked.solve(r.problem, copied);
+  ASSERT_TRUE(a.converged) << describe(a);
+  EXPECT_GT(a.iterations, 2);
+  EXPECT_EQ(a.iterations, b.iterations);
+  for (std::size_t i = 0; i < in_sweep.lambda.size(); ++i) {
+    EXPECT_EQ(in_sweep.lambda[i], copied.lambda[i]) << "contact " << i;
+  }
+}
+
+// The solver's report of a compact solve, computed in one pass from the returned (Λ, u), is the
+// natural-map residual of Λ with u recomputed from Λ (velocities_from_percussions), and ‖c‖ that
+// of the free contact velocities, to rounding.
+TEST(CompactProblem, TheReportIsTheResidualOfTheReturnedPercussions) {
+  const Random r = random_problem(8, 24, false, 17);
+  std::vector<double> mu;
+  std::vector<Vector3> c;
+  for (const CompactContact& k : r.problem.contacts) {
+    mu.push_back(k.mu);
+    c.push_back(contact_velocity(k, r.problem.u_free) + k.xi_A);
+  }
+  for (const Method method : {Method::sor, Method::jor, Method::apgd}) {
+    SolverOptions options;
+    options.min_iterations = options.max_iterations = 7;  // far from converged: residual ≫ 0
+    ContactSolution solution;
+    ContactSolver solver(method, options);
+    const SolverResult result = solver.solve(r.problem, solution);
+    std::vector<Vector6> u;
+    velocities_from_percussions(r.problem, solution.lambda, u);
+    std::vector<Vector3> xi;
+    for (const CompactContact& k : r.problem.contacts)
+      xi.push_back(contact_velocity(k, u) + k.xi_A);
+    const double expected = natural_map_residual(solution.lambda, xi, mu);
+    EXPECT_GT(expected, 1e-6) << method_name(method);
+    EXPECT_NEAR(result.residual, expected, 1e-12 * expected) << method_name(method);
+    double sum = 0.0;
+    for (const Vector3& v : c) sum += v.squaredNorm();
+    EXPECT_NEAR(result.norm_c, std::sqrt(sum), 1e-14 * std::sqrt(sum)) << method_name(method);
+  }
 }
 
 TEST(CompactProblem, ValidationNamesTheBadEntry) {

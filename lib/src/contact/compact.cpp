@@ -8,6 +8,8 @@
 #include <cmath>
 #include <string>
 
+#include "grbd/contact/detail/compact_kernels.hpp"
+#include "grbd/contact/solver.hpp"
 #include "grbd/core/checks.hpp"
 #include "grbd/core/error.hpp"
 
@@ -58,20 +60,21 @@ void validate(const CompactProblem& problem) {
       refuse("body " + std::to_string(b) +
              ": the problem is marked isotropic but I_Theta_inv is not a multiple of I");
     }
-    if (!problem.u_free[b].allFinite()) refuse("body " + std::to_string(b) + ": u_free is not finite");
+    if (!problem.u_free[b].allFinite())
+      refuse("body " + std::to_string(b) + ": u_free is not finite");
   }
   for (std::size_t i = 0; i < problem.contacts.size(); ++i) {
     const CompactContact& c = problem.contacts[i];
     const auto check = [&](BodyIndex body, const char* side) {
       if (body != kStatic && (body < 0 || static_cast<std::size_t>(body) >= bodies)) {
         refuse(contact_name(i) + ": body_" + side + " = " + std::to_string(body) +
-               " is neither kStatic (-1) nor a body index in [0, " + std::to_string(bodies) +
-               ")");
+               " is neither kStatic (-1) nor a body index in [0, " + std::to_string(bodies) + ")");
       }
     };
     check(c.body_a, "a");
     check(c.body_b, "b");
-    if (c.body_a == kStatic && c.body_b == kStatic) refuse(contact_name(i) + ": both sides are static");
+    if (c.body_a == kStatic && c.body_b == kStatic)
+      refuse(contact_name(i) + ": both sides are static");
     if (c.body_a == c.body_b) {
       refuse(contact_name(i) + ": body " + std::to_string(c.body_a) + " touches itself");
     }
@@ -81,7 +84,8 @@ void validate(const CompactProblem& problem) {
     }
     if (std::abs(c.n.norm() - 1.0) > 1e-9 || std::abs(c.t1.norm() - 1.0) > 1e-9 ||
         std::abs(c.n.dot(c.t1)) > 1e-9) {
-      refuse(contact_name(i) + ": expected a unit normal n and a unit tangent t1 ⟂ n, found |n| = " +
+      refuse(contact_name(i) +
+             ": expected a unit normal n and a unit tangent t1 ⟂ n, found |n| = " +
              format_number(c.n.norm()) + ", |t1| = " + format_number(c.t1.norm()) +
              ", n·t1 = " + format_number(c.n.dot(c.t1)));
     }
@@ -103,6 +107,22 @@ Matrix3 delassus_block(const CompactContact& c, std::span<const WorldInverseMass
     C.col(1) = r.cross(c.t1);
     C.col(2) = r.cross(t2);
     G += M.inv_m * Matrix3::Identity() + C.transpose() * M.I_Theta_inv * C;
+  };
+  add(c.body_a, c.r_a);
+  add(c.body_b, c.r_b);
+  return G;
+}
+
+Vector3 delassus_diagonal(const CompactContact& c, std::span<const WorldInverseMass> M_inv) {
+  const Vector3 f[3] = {c.n, c.t1, c.t2()};
+  Vector3 G = Vector3::Zero();
+  const auto add = [&](BodyIndex body, const Vector3& r) {
+    if (body == kStatic) return;
+    const WorldInverseMass& M = M_inv[static_cast<std::size_t>(body)];
+    for (int k = 0; k < 3; ++k) {
+      const Vector3 ck = r.cross(f[k]);
+      G(k) += M.inv_m + ck.dot(M.I_Theta_inv * ck);
+    }
   };
   add(c.body_a, c.r_a);
   add(c.body_b, c.r_b);
@@ -151,15 +171,84 @@ void velocities_from_percussions(const CompactProblem& problem, std::span<const 
   }
 }
 
+namespace {
+
+template <bool Isotropic>
+double start_solve_kernel(const CompactProblem& problem, std::span<const Vector3> lambda,
+                          double alpha, std::span<RFactors> r, std::vector<Vector6>& u) {
+  const std::size_t n = problem.contacts.size();
+  u.assign(problem.u_free.begin(), problem.u_free.end());
+  const CompactContact* contacts = problem.contacts.data();
+  const Vector6* u_free = problem.u_free.data();
+  const WorldInverseMass* M_inv = problem.M_inv.data();
+  Vector6* U = u.data();
+  constexpr std::size_t kAhead = 8;  // contacts; the records themselves stream in order
+  const auto prefetch = [&](BodyIndex b) {
+    if (b == kStatic) return;
+    const auto k = static_cast<std::size_t>(b);
+    __builtin_prefetch(&U[k], 1);
+    __builtin_prefetch(reinterpret_cast<const char*>(&U[k] + 1) - 1, 1);
+    __builtin_prefetch(&u_free[k]);
+    __builtin_prefetch(reinterpret_cast<const char*>(&u_free[k] + 1) - 1);
+    __builtin_prefetch(&M_inv[k]);
+    __builtin_prefetch(reinterpret_cast<const char*>(&M_inv[k] + 1) - 1);
+  };
+  double sum = 0.0;
+  for (std::size_t i = 0; i < n; ++i) {
+    if (i + kAhead < n) {
+      prefetch(contacts[i + kAhead].body_a);
+      prefetch(contacts[i + kAhead].body_b);
+    }
+    const CompactContact& c = contacts[i];
+    const Vector3 f[3] = {c.n, c.t1, c.t2()};
+    // r_factors() reads the diagonal of G_ii only.
+    if (!r.empty()) {
+      double G[3] = {0.0, 0.0, 0.0};
+      if (c.body_a != kStatic) {
+        detail::add_delassus_diagonal<Isotropic>(M_inv[c.body_a], c.r_a, f, G);
+      }
+      if (c.body_b != kStatic) {
+        detail::add_delassus_diagonal<Isotropic>(M_inv[c.body_b], c.r_b, f, G);
+      }
+      r[i] = r_factors(Matrix3(Vector3(G[0], G[1], G[2]).asDiagonal()), alpha);
+    }
+    // c_i = Fᵀ(v_a + ω_a × r_a − v_b − ω_b × r_b) + xi_A from the free velocities.
+    double w[3] = {0.0, 0.0, 0.0};
+    if (c.body_a != kStatic) detail::add_point_velocity(1.0, u_free[c.body_a].data(), c.r_a, w);
+    if (c.body_b != kStatic) detail::add_point_velocity(-1.0, u_free[c.body_b].data(), c.r_b, w);
+    for (int k = 0; k < 3; ++k) {
+      const double ck = f[k](0) * w[0] + f[k](1) * w[1] + f[k](2) * w[2] + c.xi_A(k);
+      sum += ck * ck;
+    }
+    const Vector3& l = lambda[i];
+    if (l.isZero(0.0)) continue;
+    double P[3];
+    detail::world_percussion(c, f[2], l, P);
+    if (c.body_a != kStatic)
+      detail::apply_percussion<Isotropic>(1.0, M_inv[c.body_a], c.r_a, P, U[c.body_a].data());
+    if (c.body_b != kStatic)
+      detail::apply_percussion<Isotropic>(-1.0, M_inv[c.body_b], c.r_b, P, U[c.body_b].data());
+  }
+  return sum;
+}
+
+}  // namespace
+
+double start_solve(const CompactProblem& problem, std::span<const Vector3> lambda, double alpha,
+                   std::span<RFactors> r, std::vector<Vector6>& u) {
+  return problem.isotropic ? start_solve_kernel<true>(problem, lambda, alpha, r, u)
+                           : start_solve_kernel<false>(problem, lambda, alpha, r, u);
+}
+
 ContactProblem body_form(const CompactProblem& problem, std::span<const InverseMass> M_inv,
                          std::span<const Matrix3> A_IK) {
   const std::size_t n = problem.M_inv.size();
   if (M_inv.size() != n || A_IK.size() != n || problem.u_free.size() != n) {
     throw InvalidArgument("body_form: expected " + std::to_string(n) +
                           " inverse masses, orientations and free velocities (one per body), "
-                          "found " + std::to_string(M_inv.size()) + ", " +
-                          std::to_string(A_IK.size()) + " and " +
-                          std::to_string(problem.u_free.size()));
+                          "found " +
+                          std::to_string(M_inv.size()) + ", " + std::to_string(A_IK.size()) +
+                          " and " + std::to_string(problem.u_free.size()));
   }
   ContactProblem out;
   out.M_inv.assign(M_inv.begin(), M_inv.end());

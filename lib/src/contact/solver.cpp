@@ -185,6 +185,59 @@ Vector3 prox_update(ProxForm form, const Vector3& lambda, const Vector3& xi, con
                                          : de_saxce_update(lambda, xi, std::min(r.r_N, r.r_T), mu);
 }
 
+/// Before the first iteration, in passes over all contacts: the per-contact r-factors into *r
+/// (when r is given), u in step with the initial Λ, and ‖c‖ = ‖ξ(0)‖, returned.
+template <class Model>
+double prepare_in_passes(Model& model, std::vector<RFactors>* r, double alpha, Workspace& ws) {
+  if (r != nullptr) {
+    r->resize(model.size());
+    for (std::size_t i = 0; i < r->size(); ++i) (*r)[i] = r_factors(model.delassus(i), alpha);
+  }
+  model.synchronize();
+  model.free_velocities(ws.xi);
+  return norm(ws.xi);
+}
+
+/// μ_i of every contact into ws.mu, for the natural map.
+template <class Model>
+void gather_mu(const Model& model, Workspace& ws) {
+  ws.mu.resize(model.size());
+  for (std::size_t i = 0; i < ws.mu.size(); ++i) ws.mu[i] = model.mu(i);
+}
+
+/// After the last iteration, in passes: ξ(Λ) evaluated afresh from Λ, the natural residual,
+/// norm_max = max(‖c‖, ‖Λ‖, ‖ξ‖). A non-finite Λ or residual is divergence, never convergence.
+template <class Model>
+void summarize_in_passes(Model& model, Workspace& ws, SolverResult& result) {
+  gather_mu(model, ws);
+  const std::span<const Vector3> lambda = model.lambda();
+  model.velocities(lambda, ws.xi);
+  result.residual = residual_norm(lambda, ws.xi, ws.mu);
+  result.norm_max = std::max({result.norm_c, norm(lambda), norm(ws.xi)});
+  if (!all_finite(lambda) || !std::isfinite(result.residual)) {
+    result.diverged = true;
+    result.converged = false;
+  }
+}
+
+/// A sum of squares with its largest magnitude: the plain square root where the sum is neither
+/// zero nor out of range, else "ask the careful pass" (−1), as euclidean_norm() decides.
+struct SquareSum {
+  double sum = 0.0;
+  double largest = 0.0;
+  void add(const Vector3& v) {
+    for (int k = 0; k < 3; ++k) sum += v(k) * v(k);
+    largest = std::max(largest, v.cwiseAbs().maxCoeff());
+  }
+  double norm() const {
+    if (largest == 0.0 && sum == 0.0) return 0.0;
+    if (sum >= std::numeric_limits<double>::min() && sum <= std::numeric_limits<double>::max()) {
+      return std::sqrt(sum);
+    }
+    return -1.0;
+  }
+};
+
 /// The body form: Λ and the body velocities u that go with it (the caller's ContactSolution).
 class BodyModel {
  public:
@@ -245,6 +298,12 @@ class BodyModel {
   bool lambda_finite() const { return all_finite(lambda_); }
   /// Λ or u changed outside the model (the hook).
   void touched() {}
+  /// r-factors, u and ‖c‖ before the first iteration (prepare_in_passes()).
+  double prepare(std::vector<RFactors>* r, double alpha) {
+    return prepare_in_passes(*this, r, alpha, ws_);
+  }
+  /// Residual and norms after the last (summarize_in_passes()).
+  void summarize(SolverResult& result) { summarize_in_passes(*this, ws_, result); }
 
  private:
   /// u = u_free + M⁻¹ W Λ, as velocities_from_percussions() computes it.
@@ -332,6 +391,12 @@ class LocalModel {
   bool lambda_finite() const { return all_finite(lambda_); }
   /// Λ changed outside the model (the hook).
   void touched() {}
+  /// r-factors, the seen ξ and ‖q‖ before the first iteration (prepare_in_passes()).
+  double prepare(std::vector<RFactors>* r, double alpha) {
+    return prepare_in_passes(*this, r, alpha, ws_);
+  }
+  /// Residual and norms after the last (summarize_in_passes()).
+  void summarize(SolverResult& result) { summarize_in_passes(*this, ws_, result); }
 
  private:
   const LocalProblem& problem_;
@@ -378,15 +443,68 @@ class CompactModel {
   }
   void done() { synchronize(); }
   void sor_sweep(std::span<const RFactors> r, ProxForm form) {
-    sweep_finite_ = contact::sor_sweep(problem_, r, form, u_, lambda_);
+    sweep_ = contact::sor_sweep(problem_, r, form, u_, lambda_, change_abs_, change_rel_);
     sweep_fresh_ = true;
+  }
+  /// From now on each sweep also applies the percussion criterion to its own change of Λ (the
+  /// monitor then keeps no copy of Λ).
+  void test_change_in_sweep(double abs_tol, double rel_tol) {
+    change_abs_ = abs_tol;
+    change_rel_ = rel_tol;
+  }
+  /// The last sweep's verdict on the percussion criterion.
+  bool sweep_settled() const { return sweep_.settled; }
+
+  /// One pass over the contacts instead of three (start_solve()): r-factors from the diagonal of
+  /// G_ii (when r is given), c_i = ξ_i(0) for ‖c‖, and the initial percussions added to
+  /// u = u_free + M⁻¹ W Λ. A sum of squares that is zero or out of range goes to the careful
+  /// passes.
+  double prepare(std::vector<RFactors>* r, double alpha) {
+    if (r != nullptr) r->resize(size());
+    const double sum = start_solve(problem_, lambda_, alpha,
+                                   r != nullptr ? std::span<RFactors>(*r) : std::span<RFactors>(),
+                                   u_);
+    if (sum >= std::numeric_limits<double>::min() && sum <= std::numeric_limits<double>::max()) {
+      return std::sqrt(sum);
+    }
+    free_velocities(ws_.xi);
+    return norm(ws_.xi);
+  }
+
+  /// One pass instead of five: ξ = Wᵀu + xi_A from the u the solver returns, which every method
+  /// keeps in step with Λ (SOR after each update, JOR and APGD in done()), the natural map and
+  /// the norms. The residual is that of (Λ, u) as returned; it differs from one evaluated with u
+  /// recomputed from Λ by the rounding of the accumulated updates. Sums that are zero or out of
+  /// range, and non-finite ones, go to the careful passes.
+  void summarize(SolverResult& result) {
+    SquareSum F, lambda, xi;
+    bool F_zero = true;
+    for (std::size_t i = 0; i < size(); ++i) {
+      const CompactContact& c = problem_.contacts[i];
+      const Vector3 x = contact_velocity(c, u_) + c.xi_A;
+      const Vector3 f = natural_map(lambda_[i], x, c.mu);
+      F.sum += f.squaredNorm();
+      F_zero = F_zero && f.isZero(0.0);
+      lambda.add(lambda_[i]);
+      xi.add(x);
+    }
+    const double norm_l = lambda.norm();
+    const double norm_x = xi.norm();
+    const bool F_ok = (F.sum == 0.0 && F_zero) || (F.sum >= std::numeric_limits<double>::min() &&
+                                                   F.sum <= std::numeric_limits<double>::max());
+    if (!F_ok || norm_l < 0.0 || norm_x < 0.0) {
+      summarize_in_passes(*this, ws_, result);
+      return;
+    }
+    result.residual = std::sqrt(F.sum);
+    result.norm_max = std::max({result.norm_c, norm_l, norm_x});
   }
   std::span<const double> watched_velocity() const { return flat(std::span<const Vector6>(u_)); }
   /// After a sweep the sweep's own test (no second pass over Λ); else a pass.
   bool lambda_finite() {
     if (sweep_fresh_) {
       sweep_fresh_ = false;
-      return sweep_finite_;
+      return sweep_.finite;
     }
     return all_finite(lambda_);
   }
@@ -410,7 +528,9 @@ class CompactModel {
   std::vector<Vector6>& u_;
   Workspace& ws_;
   bool sweep_fresh_ = false;
-  bool sweep_finite_ = true;
+  SweepReport sweep_;
+  double change_abs_ = std::numeric_limits<double>::infinity();  // no test unless asked
+  double change_rel_ = 0.0;
 };
 
 /// How the power iteration starts.
@@ -489,12 +609,19 @@ enum class Verdict { diverged, met, not_met };
 template <class Model>
 class Monitor {
  public:
-  Monitor(Model& model, const SolverOptions& options, Workspace& ws, SolverResult& result)
-      : model_(model), options_(options), ws_(ws), result_(result) {
-    model.free_velocities(ws_.xi);
-    result_.norm_c = norm(ws_.xi);
-    ws_.mu.resize(model.size());
-    for (std::size_t i = 0; i < ws_.mu.size(); ++i) ws_.mu[i] = model.mu(i);
+  /// result.norm_c must be set (Model::prepare()). With `change_in_sweep` the model's sweep
+  /// applies the percussion criterion itself (Model::sweep_settled()) and no copy of Λ is kept.
+  Monitor(Model& model, const SolverOptions& options, Workspace& ws, SolverResult& result,
+          bool change_in_sweep)
+      : model_(model),
+        options_(options),
+        ws_(ws),
+        result_(result),
+        change_in_sweep_(change_in_sweep) {
+    // μ for the natural map of the iterations, where it is read.
+    if (options.record_history || options.criterion == Criterion::natural_residual) {
+      gather_mu(model, ws);
+    }
   }
 
   /// Call before iteration k changes Λ. Before min_iterations the criterion is not read, so
@@ -502,7 +629,7 @@ class Monitor {
   /// once.
   void before(int k) {
     if (k < options_.min_iterations) return;
-    if (options_.criterion == Criterion::percussion_change) {
+    if (options_.criterion == Criterion::percussion_change && !change_in_sweep_) {
       const std::span<const Vector3> lambda = model_.lambda();
       ws_.lambda_old.assign(lambda.begin(), lambda.end());
     }
@@ -535,6 +662,12 @@ class Monitor {
     bool met = false;
     switch (options_.criterion) {
       case Criterion::percussion_change:
+        if constexpr (requires { model_.sweep_settled(); }) {
+          if (change_in_sweep_) {
+            met = model_.sweep_settled();
+            break;
+          }
+        }
         met = has_converged(flat(std::span<const Vector3>(ws_.lambda_old)), flat(lambda),
                             options_.abs_tol, options_.rel_tol);
         break;
@@ -555,23 +688,16 @@ class Monitor {
     return residual_norm(model_.lambda(), ws_.xi, ws_.mu);
   }
 
-  /// Fills residual and norm_max for the returned Λ. A non-finite Λ or residual is divergence,
-  /// never convergence.
-  void finish() {
-    result_.residual = natural_residual();
-    const std::span<const Vector3> lambda = model_.lambda();
-    result_.norm_max = std::max({result_.norm_c, norm(lambda), norm(ws_.xi)});
-    if (!all_finite(lambda) || !std::isfinite(result_.residual)) {
-      result_.diverged = true;
-      result_.converged = false;
-    }
-  }
+  /// Fills residual and norm_max for the returned Λ (Model::summarize()). A non-finite Λ or
+  /// residual is divergence, never convergence.
+  void finish() { model_.summarize(result_); }
 
  private:
   Model& model_;
   const SolverOptions& options_;
   Workspace& ws_;
   SolverResult& result_;
+  bool change_in_sweep_;
 };
 
 /// SOR: one Gauss–Seidel sweep per iteration; u is always in step with Λ.
@@ -836,11 +962,25 @@ SolverResult run(Method method, Model& model, const SolverOptions& options,
   const auto start = Clock::now();
   SolverResult result;
   result.solver = method_name(method);  // at most 4 characters: no allocation
+  // Per-contact r-factors come with the model's first pass; the spectral ones need G applied.
+  bool per_contact = false;
   if (method != Method::apgd) {
-    compute_r_factors(model, resolve(options.r_strategy, method), options.alpha, ws);
+    const RFactorStrategy strategy = resolve(options.r_strategy, method);
+    per_contact = strategy == RFactorStrategy::per_contact;
+    if (!per_contact) compute_r_factors(model, strategy, options.alpha, ws);
   }
-  model.synchronize();
-  Monitor<Model> monitor(model, options, ws, result);
+  result.norm_c = model.prepare(per_contact ? &ws.r : nullptr, options.alpha);
+  // SOR on a model whose sweep can test its own change needs no copy of Λ per iteration, unless
+  // a hook may change Λ between the sweep and the test.
+  bool change_in_sweep = false;
+  if constexpr (requires { model.test_change_in_sweep(0.0, 0.0); }) {
+    if (method == Method::sor && !hooks.after_iteration &&
+        options.criterion == Criterion::percussion_change) {
+      model.test_change_in_sweep(options.abs_tol, options.rel_tol);
+      change_in_sweep = true;
+    }
+  }
+  Monitor<Model> monitor(model, options, ws, result, change_in_sweep);
   switch (method) {
     case Method::sor: {
       SorPolicy<Model> policy(model, options, ws);

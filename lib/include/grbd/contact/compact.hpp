@@ -12,6 +12,7 @@
 /// world-frame inverse inertia I_Θ⁻¹ = A_IK K_Θ⁻¹ A_IKᵀ per body, a full symmetric 3 × 3 matrix
 /// (c·I for a sphere), recomputed when the orientation changes, i.e. once per step.
 
+#include <limits>
 #include <span>
 #include <vector>
 
@@ -69,6 +70,11 @@ void validate(const CompactProblem& problem);
 /// (1/m) I₃ + Cᵀ I_Θ⁻¹ C per dynamic side, with C = [r × n, r × t1, r × t2].
 Matrix3 delassus_block(const CompactContact& contact, std::span<const WorldInverseMass> M_inv);
 
+/// The diagonal of delassus_block(): G_kk = Σ_sides 1/m + c_kᵀ I_Θ⁻¹ c_k with c_k = r × f_k for
+/// the frame f = (n, t1, t2), all the r-factors read (chapter 5's r_factors()), at a third of
+/// the cost of the block.
+Vector3 delassus_diagonal(const CompactContact& contact, std::span<const WorldInverseMass> M_inv);
+
 /// γ = W_aᵀ u_a − W_bᵀ u_b of one compact contact for world-frame body velocities u.
 Vector3 contact_velocity(const CompactContact& contact, std::span<const Vector6> u);
 
@@ -86,6 +92,15 @@ void add_percussion(const CompactContact& contact, const Vector3& lambda,
 void velocities_from_percussions(const CompactProblem& problem, std::span<const Vector3> lambda,
                                  std::vector<Vector6>& u);
 
+/// What a solver does before its first iteration, in one pass over the contacts with the bodies
+/// of the contacts ahead prefetched: u = u_free + M⁻¹ W Λ for the initial percussions Λ (u
+/// resized to one entry per body); when r is not empty (one entry per contact), the per-contact
+/// r-factors r_factors(G_ii, α) from delassus_diagonal(); and the sum of squares of the free
+/// contact velocities c_i = W_iᵀ u_free + xi_A, returned, from which ‖c‖ follows. Contacts are not
+/// re-checked: `problem` must be one that validate() accepted.
+double start_solve(const CompactProblem& problem, std::span<const Vector3> lambda, double alpha,
+                   std::span<RFactors> r, std::vector<Vector6>& u);
+
 /// The same problem in the body form of chapter 5, for bodies with principal-frame inverse masses
 /// `M_inv` and orientations `A_IK` (those the compact problem was built with, one per body):
 /// W_s = [F; A_IKᵀ (r_s × F)], u_free with ω in frame K, γ_A = xi_A with ε_N = ε_T = 1. The
@@ -95,15 +110,28 @@ ContactProblem body_form(const CompactProblem& problem, std::span<const InverseM
                          std::span<const Matrix3> A_IK);
 
 // [compact sweep declaration]
+/// What one compact sweep saw (sor_sweep()).
+struct SweepReport {
+  /// Every updated percussion is finite: the test of divergence, folded into the sweep (a
+  /// non-finite component makes 0 · λ a NaN) instead of a second pass over Λ.
+  bool finite = true;
+  /// Every component of every λ moved by at most abs_tol + rel_tol |λ_new|: has_converged() of
+  /// the sweep's own change, without a copy of Λ (always true with the default tolerances).
+  bool settled = true;
+};
+
 /// One Gauss–Seidel sweep over a compact problem: for contacts 0, 1, …, n − 1 in order, the
 /// contact velocity seen now, ξ = γ + xi_A, the prox update of `form` (as sor_contact_update()
-/// of chapter 5), and the body velocities follow the change at once. Returns whether every
-/// updated percussion is finite: the test of divergence, folded into the sweep (a non-finite
-/// component makes 0 · λ a NaN) instead of a second pass over Λ. Throws InvalidArgument unless r
-/// and lambda have one entry per contact and u one per body (O(1)); the contacts themselves are
-/// not re-checked: `problem` must be one that validate() accepted.
-bool sor_sweep(const CompactProblem& problem, std::span<const RFactors> r, ProxForm form,
-               std::span<Vector6> u, std::span<Vector3> lambda);
+/// of chapter 5), and the body velocities follow the change at once. Reports whether every
+/// updated percussion is finite and whether the change of each stayed within
+/// abs_tol + rel_tol |λ_new| (the percussion criterion of the solvers, evaluated in the sweep).
+/// Throws InvalidArgument unless r and lambda have one entry per contact and u one per body
+/// (O(1)); the contacts themselves are not re-checked: `problem` must be one that validate()
+/// accepted.
+SweepReport sor_sweep(const CompactProblem& problem, std::span<const RFactors> r, ProxForm form,
+                      std::span<Vector6> u, std::span<Vector3> lambda,
+                      double abs_tol = std::numeric_limits<double>::infinity(),
+                      double rel_tol = 0.0);
 // [compact sweep declaration]
 
 }  // namespace grbd::contact
