@@ -17,6 +17,7 @@
 #include "grbd/core/error.hpp"
 #include "grbd/timestep/midpoint.hpp"
 #include "grbd/timestep/stepper.hpp"
+#include "pile.hpp"
 #include "scenes.hpp"
 
 namespace grbd::timestep {
@@ -522,6 +523,46 @@ TEST(Stepper, ReportsEnergiesPenetrationAndStageTimes) {
   EXPECT_NEAR(r.potential_energy, system.inertia()[0].m * kG * system.states()[0].q.z(), 1e-12);
   EXPECT_GE(r.seconds.total, r.seconds.solve);
   EXPECT_GE(r.seconds.solve, 0.0);
+}
+
+// Jacobi (JOR) with the default options is safe: its spectral r-factors make it a contraction,
+// so it never diverges and every iteration brings it closer. But it is slow: the error of Jacobi
+// falls by about 1 − λ_min/λ_max of G per iteration, and on a small settled pile of spheres it
+// needs more than the default cap of 1000 iterations, where Gauss–Seidel (SOR) with per-contact
+// r-factors needs a few dozen from zero (chapter 6, "Which solver").
+TEST(SolverChoice, JorWithDefaultOptionsIsSafeButSlowOnAPile) {
+  BodySystem system;
+  StaticGeometry statics;
+  demo::fcc_pile(system, statics, 3, 3, 3);
+  const MaterialTable materials = demo::glass_materials();
+  StepSettings settings;
+  settings.dt = 2e-4;
+  MoreauStepper stepper(system, statics, materials, settings);
+  for (int k = 0; k < 20; ++k) stepper.step();
+  const contact::CompactProblem problem = stepper.problem();
+  ASSERT_GT(problem.contacts.size(), 2 * system.size());
+
+  const auto solve = [&](contact::Method method, int max_iterations) {
+    contact::SolverOptions options;  // the defaults but for the cap
+    options.max_iterations = max_iterations;
+    contact::ContactSolver solver(method, options);
+    contact::ContactSolution solution;  // from Λ = 0
+    return solver.solve(problem, solution);
+  };
+  const contact::SolverResult capped = solve(contact::Method::jor, 1000);
+  EXPECT_FALSE(capped.diverged) << describe(capped);
+  EXPECT_FALSE(capped.converged) << describe(capped);
+  EXPECT_EQ(capped.iterations, 1000);
+  EXPECT_LT(capped.residual, 0.1 * capped.norm_c) << describe(capped);
+
+  const contact::SolverResult jor = solve(contact::Method::jor, 100000);
+  const contact::SolverResult sor = solve(contact::Method::sor, 100000);
+  ASSERT_TRUE(jor.converged) << describe(jor);
+  ASSERT_TRUE(sor.converged) << describe(sor);
+  std::printf("3 x 3 x 3 pile, %zu contacts, from zero: JOR %d iterations, SOR %d\n",
+              problem.contacts.size(), jor.iterations, sor.iterations);
+  EXPECT_GT(jor.iterations, 1000);
+  EXPECT_LT(10 * sor.iterations, jor.iterations);
 }
 
 TEST(DriftCorrection, OffKeepsOverlapsOnRemovesThemGeometricallyWithoutVelocity) {
