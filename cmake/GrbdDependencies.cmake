@@ -52,6 +52,10 @@ endif()
 find_package(CLI11 2.1 QUIET CONFIG)
 grbd_require(CLI11_FOUND "CLI11 >= 2.1 (command lines)" libcli11-dev)
 
+# toml++ 3: the scene files of Chapter 7.
+find_package(tomlplusplus 3 QUIET CONFIG)
+grbd_require(tomlplusplus_FOUND "toml++ >= 3 (scene files)" libtomlplusplus-dev)
+
 find_package(benchmark QUIET)
 grbd_require(benchmark_FOUND "Google Benchmark" libbenchmark-dev)
 
