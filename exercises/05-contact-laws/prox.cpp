@@ -192,6 +192,7 @@ namespace {
 
 using detail::add_point_velocity;
 using detail::apply_percussion;
+using detail::world_percussion;
 
 // [compact sweep kernel]
 /// The sweep of sor_sweep(const CompactProblem&, …), for general or isotropic inverse inertias.
@@ -228,9 +229,8 @@ template <bool Isotropic>
       unsettled |= !(std::abs(delta(k)) <= abs_tol + rel_tol * std::abs(updated(k)));
     }
     if (delta.isZero(0.0)) continue;  // Δλ = 0 exactly: the velocities stay as they are
-    const double P[3] = {c.n(0) * delta(0) + c.t1(0) * delta(1) + t2(0) * delta(2),
-                         c.n(1) * delta(0) + c.t1(1) * delta(1) + t2(1) * delta(2),
-                         c.n(2) * delta(0) + c.t1(2) * delta(1) + t2(2) * delta(2)};
+    double P[3];  // the world percussion F Δλ
+    world_percussion(c, t2, delta, P);
     if (c.body_a != kStatic) {
       apply_percussion<Isotropic>(1.0, M_inv[c.body_a], c.r_a, P, U[c.body_a].data());
     }

@@ -114,19 +114,7 @@ Matrix3 delassus_block(const CompactContact& c, std::span<const WorldInverseMass
 }
 
 Vector3 delassus_diagonal(const CompactContact& c, std::span<const WorldInverseMass> M_inv) {
-  const Vector3 f[3] = {c.n, c.t1, c.t2()};
-  Vector3 G = Vector3::Zero();
-  const auto add = [&](BodyIndex body, const Vector3& r) {
-    if (body == kStatic) return;
-    const WorldInverseMass& M = M_inv[static_cast<std::size_t>(body)];
-    for (int k = 0; k < 3; ++k) {
-      const Vector3 ck = r.cross(f[k]);
-      G(k) += M.inv_m + ck.dot(M.I_Theta_inv * ck);
-    }
-  };
-  add(c.body_a, c.r_a);
-  add(c.body_b, c.r_b);
-  return G;
+  return detail::delassus_diagonal<false>(c, M_inv.data());
 }
 
 Vector3 contact_velocity(const CompactContact& c, std::span<const Vector6> u) {
@@ -203,14 +191,7 @@ double start_solve_kernel(const CompactProblem& problem, std::span<const Vector3
     const Vector3 f[3] = {c.n, c.t1, c.t2()};
     // r_factors() reads the diagonal of G_ii only.
     if (!r.empty()) {
-      double G[3] = {0.0, 0.0, 0.0};
-      if (c.body_a != kStatic) {
-        detail::add_delassus_diagonal<Isotropic>(M_inv[c.body_a], c.r_a, f, G);
-      }
-      if (c.body_b != kStatic) {
-        detail::add_delassus_diagonal<Isotropic>(M_inv[c.body_b], c.r_b, f, G);
-      }
-      r[i] = r_factors(Matrix3(Vector3(G[0], G[1], G[2]).asDiagonal()), alpha);
+      r[i] = r_factors(Matrix3(detail::delassus_diagonal<Isotropic>(c, M_inv).asDiagonal()), alpha);
     }
     // c_i = Fᵀ(v_a + ω_a × r_a − v_b − ω_b × r_b) + xi_A from the free velocities.
     double w[3] = {0.0, 0.0, 0.0};

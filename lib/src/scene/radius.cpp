@@ -153,7 +153,22 @@ RadiusDistribution RadiusDistribution::piecewise_constant(std::vector<double> ed
   return d;
 }
 
-double RadiusDistribution::normal_moment(int j) const {
+double RadiusDistribution::moment(int j) const {
+  switch (kind_) {
+    case Kind::fixed:
+      return std::pow(lo_, j);
+    case Kind::uniform:
+      return uniform_moment(lo_, hi_, j);
+    case Kind::piecewise_constant: {
+      double sum = 0.0;
+      for (std::size_t k = 0; k < probability_.size(); ++k) {
+        sum += probability_[k] * uniform_moment(edges_[k], edges_[k + 1], j);
+      }
+      return sum;
+    }
+    case Kind::truncated_normal:
+      break;
+  }
   // Moments m_k of the standard normal truncated to [α, β]: m_0 = 1, and by parts
   // m_k = (k − 1) m_{k−2} + (α^{k−1} φ(α) − β^{k−1} φ(β)) / Z; then E[(μ + σ z)^j].
   const double alpha = (lo_ - mean_) / sd_;
@@ -173,40 +188,9 @@ double RadiusDistribution::normal_moment(int j) const {
   return sum;
 }
 
-namespace {
-double moment(const RadiusDistribution& d, int j, const std::vector<double>& edges,
-              const std::vector<double>& p) {
-  switch (d.kind()) {
-    case RadiusDistribution::Kind::fixed:
-      return std::pow(d.min(), j);
-    case RadiusDistribution::Kind::uniform:
-      return uniform_moment(d.min(), d.max(), j);
-    case RadiusDistribution::Kind::piecewise_constant: {
-      double sum = 0.0;
-      for (std::size_t k = 0; k < p.size(); ++k) {
-        sum += p[k] * uniform_moment(edges[k], edges[k + 1], j);
-      }
-      return sum;
-    }
-    case RadiusDistribution::Kind::truncated_normal:
-      break;
-  }
-  return 0.0;
-}
-}  // namespace
-
-double RadiusDistribution::mean() const {
-  return kind_ == Kind::truncated_normal ? normal_moment(1)
-                                         : moment(*this, 1, edges_, probability_);
-}
-double RadiusDistribution::second_moment() const {
-  return kind_ == Kind::truncated_normal ? normal_moment(2)
-                                         : moment(*this, 2, edges_, probability_);
-}
-double RadiusDistribution::third_moment() const {
-  return kind_ == Kind::truncated_normal ? normal_moment(3)
-                                         : moment(*this, 3, edges_, probability_);
-}
+double RadiusDistribution::mean() const { return moment(1); }
+double RadiusDistribution::second_moment() const { return moment(2); }
+double RadiusDistribution::third_moment() const { return moment(3); }
 
 double RadiusDistribution::cdf(double r) const {
   if (std::isnan(r)) return r;

@@ -76,7 +76,7 @@ class RadiusDistribution {
 
  private:
   RadiusDistribution() = default;
-  double normal_moment(int k) const;
+  double moment(int j) const;  // E[r^j], j = 1, 2, 3
 
   Kind kind_ = Kind::fixed;
   double lo_ = 0.0;

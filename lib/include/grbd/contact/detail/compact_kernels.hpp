@@ -67,4 +67,14 @@ inline void add_delassus_diagonal(const WorldInverseMass& M, const Vector3& r, c
   }
 }
 
+/// The diagonal of G_ii of contact c: add_delassus_diagonal() over its dynamic sides.
+template <bool Isotropic>
+inline Vector3 delassus_diagonal(const CompactContact& c, const WorldInverseMass* M_inv) {
+  const Vector3 f[3] = {c.n, c.t1, c.t2()};
+  double G[3] = {0.0, 0.0, 0.0};
+  if (c.body_a != kStatic) add_delassus_diagonal<Isotropic>(M_inv[c.body_a], c.r_a, f, G);
+  if (c.body_b != kStatic) add_delassus_diagonal<Isotropic>(M_inv[c.body_b], c.r_b, f, G);
+  return {G[0], G[1], G[2]};
+}
+
 }  // namespace grbd::contact::detail
