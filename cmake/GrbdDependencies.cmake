@@ -63,6 +63,22 @@ grbd_require(benchmark_FOUND "Google Benchmark" libbenchmark-dev)
 find_package(Python3 QUIET COMPONENTS Interpreter)
 grbd_require(Python3_FOUND "Python 3" python3)
 
+# h5py and NumPy of Debian's own Python 3: chapter 7's tests and examples read output files as a
+# user does. The interpreter is /usr/bin/python3, where Debian's packages are installed (another
+# python3 earlier on PATH would not see them).
+if(GRBD_BUILD_TESTS)
+  find_program(GRBD_SYSTEM_PYTHON python3 PATHS /usr/bin NO_DEFAULT_PATH)
+  if(GRBD_SYSTEM_PYTHON)
+    execute_process(COMMAND ${GRBD_SYSTEM_PYTHON} -c "import h5py, numpy"
+                    RESULT_VARIABLE _grbd_h5py OUTPUT_QUIET ERROR_QUIET)
+    if(_grbd_h5py EQUAL 0)
+      set(GRBD_H5PY_FOUND TRUE)
+    endif()
+  endif()
+  grbd_require(GRBD_H5PY_FOUND "h5py for /usr/bin/python3 (chapter 7's tests read output files)"
+               python3-h5py)
+endif()
+
 # gnuplot draws the figures of the chapters from the data the demo programs write.
 find_program(GRBD_GNUPLOT gnuplot)
 grbd_require(GRBD_GNUPLOT "gnuplot (the figures of the book)" gnuplot-nox)

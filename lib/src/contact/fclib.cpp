@@ -40,6 +40,7 @@
 #include <system_error>
 #include <utility>
 
+#include "core/hdf5.hpp"
 #include "grbd/core/checks.hpp"
 #include "grbd/core/error.hpp"
 
@@ -60,77 +61,8 @@ constexpr std::size_t kMaxStringBytes = std::size_t{1} << 20;
 /// (and, if compressed, inflates) whole chunks, so a chunk size is an allocation.
 constexpr std::uint64_t kMaxChunkBytes = std::uint64_t{8} << 20;
 
-/// Serializes grbd's calls into HDF5 (and the error-printing switch below).
-std::mutex& hdf5_mutex() {
-  static std::mutex mutex;
-  return mutex;
-}
-
-/// Switches HDF5's automatic printing of the error stack off for its lifetime and restores the
-/// previous handler afterwards.
-class QuietErrors {
- public:
-  QuietErrors() {
-    H5Eget_auto2(H5E_DEFAULT, &function_, &data_);
-    H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
-  }
-  ~QuietErrors() { H5Eset_auto2(H5E_DEFAULT, function_, data_); }
-  QuietErrors(const QuietErrors&) = delete;
-  QuietErrors& operator=(const QuietErrors&) = delete;
-
- private:
-  H5E_auto2_t function_ = nullptr;
-  void* data_ = nullptr;
-};
-
-/// An HDF5 identifier (file, group, dataset, dataspace, datatype, property list) that is closed
-/// when the Handle goes out of scope. A negative id is "no object".
-class Handle {
- public:
-  using Close = herr_t (*)(hid_t);
-  Handle() = default;
-  Handle(hid_t id, Close close) : id_(id), close_(close) {}
-  ~Handle() { reset(); }
-  Handle(Handle&& other) noexcept
-      : id_(std::exchange(other.id_, H5I_INVALID_HID)), close_(other.close_) {}
-  Handle& operator=(Handle&& other) noexcept {
-    if (this != &other) {
-      reset();
-      id_ = std::exchange(other.id_, H5I_INVALID_HID);
-      close_ = other.close_;
-    }
-    return *this;
-  }
-  Handle(const Handle&) = delete;
-  Handle& operator=(const Handle&) = delete;
-
-  hid_t get() const { return id_; }
-  bool valid() const { return id_ >= 0; }
-
- private:
-  void reset() {
-    if (id_ >= 0 && close_ != nullptr) close_(id_);
-    id_ = H5I_INVALID_HID;
-  }
-  hid_t id_ = H5I_INVALID_HID;
-  Close close_ = nullptr;
-};
-
-/// The description of the innermost error on HDF5's default error stack (where the failure was
-/// detected), or "" if the stack is empty. Must be called right after the failing HDF5 call.
-std::string hdf5_message() {
-  std::string message;
-  H5Ewalk2(
-      H5E_DEFAULT, H5E_WALK_UPWARD,
-      [](unsigned n, const H5E_error2_t* error, void* data) -> herr_t {
-        if (n == 0 && error != nullptr && error->desc != nullptr) {
-          *static_cast<std::string*>(data) = error->desc;
-        }
-        return 0;
-      },
-      &message);
-  return message.empty() ? std::string() : " (HDF5: " + message + ")";
-}
+using hdf5::Handle;
+using hdf5::QuietErrors;
 
 std::string type_class_name(H5T_class_t type_class) {
   switch (type_class) {
@@ -240,10 +172,10 @@ class File {
     require_regular_file(path);
     const htri_t is_hdf5 = H5Fis_hdf5(name_.c_str());
     if (is_hdf5 == 0) fail("is not an HDF5 file (no HDF5 signature found)");
-    if (is_hdf5 < 0) fail("cannot be read as an HDF5 file" + hdf5_message());
+    if (is_hdf5 < 0) fail("cannot be read as an HDF5 file" + hdf5::message());
     file_ = Handle(H5Fopen(name_.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), H5Fclose);
     if (!file_.valid()) {
-      fail("cannot be opened as an HDF5 file, it may be truncated or damaged" + hdf5_message());
+      fail("cannot be opened as an HDF5 file, it may be truncated or damaged" + hdf5::message());
     }
   }
 
@@ -295,7 +227,7 @@ class File {
         fail("group " + prefix + " is missing (expected " + what + " " + object + ")");
       }
       Handle handle(H5Oopen(file_.get(), prefix.c_str(), H5P_DEFAULT), H5Oclose);
-      if (!handle.valid()) fail("cannot open " + prefix + hdf5_message());
+      if (!handle.valid()) fail("cannot open " + prefix + hdf5::message());
       const H5I_type_t type = H5Iget_type(handle.get());
       if (last) {
         if (type != expected) fail(object + " is " + object_kind(type) + ", expected a " + what);
@@ -338,7 +270,7 @@ class File {
     d.type = Handle(H5Dget_type(d.dataset.get()), H5Tclose);
     const Handle space(H5Dget_space(d.dataset.get()), H5Sclose);
     if (!d.type.valid() || !space.valid()) {
-      fail("cannot read the type or shape of dataset " + name + hdf5_message());
+      fail("cannot read the type or shape of dataset " + name + hdf5::message());
     }
     check_element(d, element);
     switch (H5Sget_simple_extent_type(space.get())) {
@@ -356,13 +288,13 @@ class File {
         }
         hsize_t dims[1] = {0};
         if (H5Sget_simple_extent_dims(space.get(), dims, nullptr) != 1) {
-          fail("cannot read the shape of dataset " + name + hdf5_message());
+          fail("cannot read the shape of dataset " + name + hdf5::message());
         }
         d.length = dims[0];
         break;
       }
       default:
-        fail("cannot read the shape of dataset " + name + hdf5_message());
+        fail("cannot read the shape of dataset " + name + hdf5::message());
     }
     return d;
   }
@@ -386,7 +318,7 @@ class File {
                          H5P_DEFAULT, values.data());
       }
     }
-    if (status < 0) fail("cannot read dataset " + d.name + hdf5_message());
+    if (status < 0) fail("cannot read dataset " + d.name + hdf5::message());
     return values;
   }
 
@@ -418,13 +350,13 @@ class File {
            " entries, expected a single string");
     }
     const Handle memory_type(H5Tcopy(H5T_C_S1), H5Tclose);
-    if (!memory_type.valid()) fail("cannot read dataset " + name + hdf5_message());
+    if (!memory_type.valid()) fail("cannot read dataset " + name + hdf5::message());
     H5Tset_cset(memory_type.get(), H5Tget_cset(d.type.get()));
     if (d.variable_string) {
       H5Tset_size(memory_type.get(), H5T_VARIABLE);
       char* text = nullptr;
       if (H5Dread(d.dataset.get(), memory_type.get(), H5S_ALL, H5S_ALL, H5P_DEFAULT, &text) < 0) {
-        fail("cannot read dataset " + name + hdf5_message());
+        fail("cannot read dataset " + name + hdf5::message());
       }
       std::string result = text != nullptr ? std::string(text) : std::string();
       const Handle space(H5Dget_space(d.dataset.get()), H5Sclose);
@@ -437,7 +369,7 @@ class File {
     std::vector<char> buffer(size, '\0');
     if (H5Dread(d.dataset.get(), memory_type.get(), H5S_ALL, H5S_ALL, H5P_DEFAULT, buffer.data()) <
         0) {
-      fail("cannot read dataset " + name + hdf5_message());
+      fail("cannot read dataset " + name + hdf5::message());
     }
     std::string result = bounded_string(buffer.data(), buffer.size());
     if (H5Tget_strpad(d.type.get()) == H5T_STR_SPACEPAD) {
@@ -680,7 +612,7 @@ class File {
   void require_hard_link(const std::string& object, const std::string& what) const {
     H5L_info_t info;
     if (H5Lget_info(file_.get(), object.c_str(), &info, H5P_DEFAULT) < 0) {
-      fail("cannot read the link " + object + hdf5_message());
+      fail("cannot read the link " + object + hdf5::message());
     }
     if (info.type == H5L_TYPE_HARD) return;
     std::string kind = "a user-defined link";
@@ -720,7 +652,7 @@ class File {
              " data, expected string data");
       }
       const htri_t variable = H5Tis_variable_str(type);
-      if (variable < 0) fail("cannot read the string type of dataset " + name + hdf5_message());
+      if (variable < 0) fail("cannot read the string type of dataset " + name + hdf5::message());
       d.variable_string = variable > 0;
       if (!d.variable_string && (size == 0 || size > kMaxStringBytes)) {
         fail("dataset " + name + " holds a string of " + std::to_string(size) +
@@ -759,7 +691,7 @@ class File {
   void check_storage(const Dataset& d) const {
     const std::string& name = d.name;
     const Handle plist_handle(H5Dget_create_plist(d.dataset.get()), H5Pclose);
-    if (!plist_handle.valid()) fail("cannot read the storage of dataset " + name + hdf5_message());
+    if (!plist_handle.valid()) fail("cannot read the storage of dataset " + name + hdf5::message());
     const hid_t plist = plist_handle.get();
     const H5D_layout_t layout = H5Pget_layout(plist);
     if (layout == H5D_VIRTUAL) {
@@ -768,7 +700,7 @@ class File {
            "the file itself");
     }
     if (layout != H5D_COMPACT && layout != H5D_CONTIGUOUS && layout != H5D_CHUNKED) {
-      fail("cannot read the storage layout of dataset " + name + hdf5_message());
+      fail("cannot read the storage layout of dataset " + name + hdf5::message());
     }
     const int external = H5Pget_external_count(plist);
     if (external != 0) {
@@ -787,7 +719,7 @@ class File {
                                  " entries of " + std::to_string(element) + " bytes (" +
                                  std::to_string(bytes) + " bytes)";
     const int filters = layout == H5D_CHUNKED ? H5Pget_nfilters(plist) : 0;
-    if (filters < 0) fail("cannot read the filters of dataset " + name + hdf5_message());
+    if (filters < 0) fail("cannot read the filters of dataset " + name + hdf5::message());
     if (filters == 0) {
       if (bytes > size_) {
         fail(declared + ", more than the " + std::to_string(size_) +
@@ -807,7 +739,7 @@ class File {
     if (layout == H5D_CHUNKED) {
       hsize_t chunk[1] = {0};
       if (H5Pget_chunk(plist, 1, chunk) != 1) {
-        fail("cannot read the chunks of dataset " + name + hdf5_message());
+        fail("cannot read the chunks of dataset " + name + hdf5::message());
       }
       const std::uint64_t chunk_bytes =
           chunk[0] > std::numeric_limits<std::uint64_t>::max() / std::max<std::uint64_t>(element, 1)
@@ -1006,7 +938,7 @@ FclibInfo read_info(const File& file) {
 /// W, or of H; /fclib_*/vectors/mu must have one entry each) and reads the optional info strings
 /// and the guess /guesses/1/r (3n entries). The matrices' entries are not read.
 FclibInfo read_fclib_info(const std::filesystem::path& path) {
-  const std::lock_guard lock(hdf5_mutex());
+  const std::lock_guard lock(hdf5::mutex());
   const QuietErrors quiet;
   return read_info(File(path));
 }
@@ -1015,7 +947,7 @@ FclibInfo read_fclib_info(const std::filesystem::path& path) {
 /// blocks), mu with n entries (finite, ≥ 0), q with 3n finite entries; the problem passes
 /// validate().
 LocalProblem read_fclib_local(const std::filesystem::path& path) {
-  const std::lock_guard lock(hdf5_mutex());
+  const std::lock_guard lock(hdf5::mutex());
   const QuietErrors quiet;
   return read_local(File(path));
 }
@@ -1023,7 +955,7 @@ LocalProblem read_fclib_local(const std::filesystem::path& path) {
 /// Reads /fclib_global: spacedim = 3, no (non-empty) G, M m × m, H m × 3n, μ (n entries), f (m),
 /// w (3n).
 GlobalProblem read_fclib_global(const std::filesystem::path& path) {
-  const std::lock_guard lock(hdf5_mutex());
+  const std::lock_guard lock(hdf5::mutex());
   const QuietErrors quiet;
   return read_global(File(path));
 }
@@ -1035,7 +967,7 @@ GlobalProblem read_fclib_global(const std::filesystem::path& path) {
 LocalProblem read_fclib_as_local(const std::filesystem::path& path) {
   GlobalProblem global;
   {
-    const std::lock_guard lock(hdf5_mutex());
+    const std::lock_guard lock(hdf5::mutex());
     const QuietErrors quiet;
     const File file(path);
     if (file.kind() == FclibKind::local) return read_local(file);
@@ -1077,7 +1009,7 @@ Eigen::SparseMatrix<double> read_fclib_matrix(const std::filesystem::path& path,
                           group + "\"");
   }
   name.insert(name.begin(), '/');
-  const std::lock_guard lock(hdf5_mutex());
+  const std::lock_guard lock(hdf5::mutex());
   const QuietErrors quiet;
   const File file(path);
   const MatrixHeader h = file.header(name);

@@ -130,6 +130,8 @@ class MoreauStepper {
   ///@}
   /// The warm starts (chapter 7 saves and restores them).
   WarmStartTable& warm_starts() { return warm_; }
+  /// The warm starts, read only.
+  const WarmStartTable& warm_starts() const { return warm_; }
 
  private:
   void check_layout();

@@ -1,0 +1,290 @@
+// The grbd command line (chapter 7): run a scene, check it, summarise an output file.
+//
+//   grbd run <scene.toml> [--output FILE] [--checkpoint FILE] [--restart CKPT] [--end-time T]
+//            [--quiet] [--progress auto|bar|lines]
+//   grbd validate <scene.toml>
+//   grbd info <output.h5>
+//
+// Exit codes (also in `grbd --help`):
+//   0    done
+//   1    the run failed (a solver diverged, a file could not be written)
+//   2    bad command line
+//   3    bad input: a scene, checkpoint or output file that cannot be used (nothing was run)
+//   130  stopped by SIGINT, 143 by SIGTERM: the step was finished, a checkpoint written and the
+//        output closed; `grbd run <scene> --restart <checkpoint>` continues
+
+#include <unistd.h>
+
+#include <CLI/CLI.hpp>
+#include <chrono>
+#include <csignal>
+#include <cstdio>
+#include <iomanip>
+#include <iostream>
+#include <optional>
+#include <sstream>
+#include <string>
+
+#include "grbd/io/output.hpp"
+#include "grbd/io/run.hpp"
+#include "grbd/scene/scene.hpp"
+#include "grbd/scene/simulation.hpp"
+
+namespace {
+
+constexpr int kExitFailed = 1;
+constexpr int kExitUsage = 2;
+constexpr int kExitInput = 3;
+
+constexpr const char* kExitCodes =
+    "Exit codes: 0 done; 1 the run failed (solver diverged, file not writable); 2 bad command "
+    "line; 3 bad input (scene, checkpoint or output file), nothing run; 130 / 143 stopped by "
+    "SIGINT / SIGTERM after writing a checkpoint (continue with --restart).";
+
+volatile std::sig_atomic_t g_signal = 0;
+
+extern "C" void on_signal(int signal) { g_signal = signal; }
+
+void install_handlers() {
+  struct sigaction action {};
+  action.sa_handler = on_signal;
+  sigemptyset(&action.sa_mask);
+  action.sa_flags = 0;
+  sigaction(SIGINT, &action, nullptr);
+  sigaction(SIGTERM, &action, nullptr);
+}
+
+std::string clock_text(double seconds) {
+  if (!(seconds >= 0.0) || seconds > 1e7) return "--:--";
+  const auto s = static_cast<long>(seconds + 0.5);
+  std::ostringstream out;
+  if (s >= 3600)
+    out << s / 3600 << ':' << std::setw(2) << std::setfill('0') << (s / 60) % 60;
+  else
+    out << s / 60;
+  out << ':' << std::setw(2) << std::setfill('0') << s % 60;
+  return out.str();
+}
+
+// The progress display: a bar redrawn in place on a terminal, a plain line every 10 s otherwise.
+class Progress {
+ public:
+  Progress(bool bar, std::uint64_t total) : bar_(bar), total_(total) {}
+
+  void update(const grbd::scene::Simulation& sim, const grbd::timestep::StepReport& report) {
+    const auto now = std::chrono::steady_clock::now();
+    if (!started_) {
+      started_ = true;
+      start_ = now;
+      last_ = now;
+      first_step_ = report.step - 1;
+    }
+    const double since = std::chrono::duration<double>(now - last_).count();
+    const bool last = report.step >= total_;
+    if (since < (bar_ ? 0.2 : 10.0) && !last) return;
+    last_ = now;
+    const double elapsed = std::chrono::duration<double>(now - start_).count();
+    const double done = static_cast<double>(report.step - first_step_);
+    const double rate = elapsed > 0.0 ? done / elapsed : 0.0;
+    const double remaining = rate > 0.0 ? static_cast<double>(total_ - report.step) / rate : -1.0;
+    const double fraction =
+        total_ > 0 ? static_cast<double>(report.step) / static_cast<double>(total_) : 1.0;
+    std::ostringstream line;
+    line << std::fixed << std::setprecision(1) << std::setw(5) << 100.0 * fraction
+         << "%  t = " << std::setprecision(4) << report.t << " / " << sim.scene().end_time
+         << " s  step " << report.step << " / " << total_ << "  " << std::setprecision(1) << rate
+         << " steps/s  ETA " << clock_text(remaining) << "  bodies " << sim.system().size()
+         << "  contacts " << report.contacts << "  iterations " << report.iterations;
+    if (bar_) {
+      constexpr int kWidth = 24;
+      const int filled = static_cast<int>(fraction * kWidth);
+      std::string bar(static_cast<std::size_t>(filled), '#');
+      bar.resize(kWidth, '.');
+      std::cerr << "\r\033[K[" << bar << "] " << line.str() << std::flush;
+      if (last) std::cerr << '\n';
+    } else {
+      std::cerr << line.str() << '\n' << std::flush;
+    }
+  }
+  void finish() {
+    if (bar_ && started_) std::cerr << '\n';
+  }
+
+ private:
+  bool bar_;
+  std::uint64_t total_;
+  bool started_ = false;
+  std::uint64_t first_step_ = 0;
+  std::chrono::steady_clock::time_point start_, last_;
+};
+
+int run_command(const std::string& scene_file, const std::optional<std::string>& output,
+                const std::optional<std::string>& checkpoint,
+                const std::optional<std::string>& restart, const std::optional<double>& end_time,
+                bool quiet, const std::string& progress) {
+  grbd::scene::Scene scene;
+  try {
+    scene = grbd::scene::load_scene(scene_file);
+  } catch (const grbd::Error& e) {
+    std::cerr << "grbd run: " << e.what() << '\n';
+    return kExitInput;
+  }
+  if (end_time) {
+    if (!(*end_time > 0.0) || !std::isfinite(*end_time)) {
+      std::cerr << "grbd run: --end-time: expected a time > 0 s\n";
+      return kExitUsage;
+    }
+    scene.end_time = *end_time;
+  }
+  grbd::io::RunOptions options;
+  options.output = output ? std::filesystem::path(*output) : scene.output.file;
+  options.checkpoint = checkpoint ? std::filesystem::path(*checkpoint) : scene.checkpoint.file;
+  if (restart) options.restart = *restart;
+  if (options.output == options.checkpoint) {
+    std::cerr << "grbd run: the output and the checkpoint must be different files, both are "
+              << options.output << '\n';
+    return kExitUsage;
+  }
+  const bool bar = progress == "bar" || (progress == "auto" && isatty(STDERR_FILENO) != 0);
+  Progress display(bar, scene.steps());
+  if (!quiet) {
+    options.on_step = [&](const grbd::scene::Simulation& sim, const grbd::timestep::StepReport& r) {
+      display.update(sim, r);
+    };
+  }
+  install_handlers();
+  options.stop = &g_signal;
+  grbd::io::RunResult result;
+  try {
+    result = grbd::io::run(scene, options);
+  } catch (const grbd::scene::SceneError& e) {
+    display.finish();
+    std::cerr << "grbd run: " << e.what() << '\n';
+    return kExitInput;
+  } catch (const grbd::io::IoError& e) {
+    display.finish();
+    std::cerr << "grbd run: " << e.what() << '\n';
+    return kExitInput;
+  } catch (const grbd::Error& e) {
+    display.finish();
+    std::cerr << "grbd run: the run failed: " << e.what() << '\n';
+    return kExitFailed;
+  }
+  display.finish();
+  if (!quiet) {
+    std::cout << (result.interrupted ? "stopped" : "done") << ": " << result.steps << " steps in "
+              << std::setprecision(3) << result.seconds << " s (output and checkpoints "
+              << 100.0 * result.output_seconds / std::max(result.seconds, 1e-300) << " %), "
+              << result.records << " records in " << options.output.string() << ", checkpoint "
+              << options.checkpoint.string() << '\n';
+  }
+  if (result.interrupted) return 128 + static_cast<int>(g_signal);
+  return 0;
+}
+
+int validate_command(const std::string& scene_file) {
+  try {
+    const grbd::scene::Scene scene = grbd::scene::load_scene(scene_file);
+    std::cout << grbd::scene::summary(scene);
+    const auto start = std::chrono::steady_clock::now();
+    grbd::scene::Simulation simulation(scene);
+    const double seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    std::cout << "  generated " << simulation.system().size() << " bodies in "
+              << std::setprecision(3) << seconds << " s\n";
+    for (std::size_t g = 0; g < scene.groups.size(); ++g) {
+      if (scene.groups[g].generator.kind == grbd::scene::GeneratorKind::inflow) {
+        std::cout << "  bodies " << scene.groups[g].name
+                  << ": created by the inflow during the run\n";
+      }
+    }
+    std::cout << "ok\n";
+    return 0;
+  } catch (const grbd::Error& e) {
+    std::cerr << "grbd validate: " << e.what() << '\n';
+    return kExitInput;
+  }
+}
+
+int info_command(const std::string& file) {
+  try {
+    const grbd::io::OutputSummary s = grbd::io::read_summary(file);
+    std::cout << "output " << file << "\n"
+              << "  scene " << s.scene_file << ", written by grbd " << s.grbd_version << " on "
+              << s.host << " at " << s.date << " (" << s.precision << ")\n"
+              << "  bodies created: " << s.bodies << "\n"
+              << "  records: " << s.records;
+    if (s.records > 0) {
+      std::cout << ", t = " << s.t_first << " … " << s.t_last << " s, " << s.bodies_last
+                << " bodies in the last";
+    }
+    std::cout << "\n  steps: " << s.steps << ", wall time " << s.seconds << " s\n"
+              << "  solver: mean " << s.mean_iterations << " iterations, at most "
+              << s.max_iterations << ", " << s.non_converged << " steps not converged\n"
+              << "  contacts: at most " << s.max_contacts << ", largest penetration "
+              << s.max_penetration << " m\n";
+    return 0;
+  } catch (const grbd::Error& e) {
+    std::cerr << "grbd info: " << e.what() << '\n';
+    return kExitInput;
+  }
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"grbd: granular rigid body dynamics — run scenes, inspect their output"};
+  app.footer(kExitCodes);
+  app.require_subcommand(1);
+
+  std::string scene_file;
+  std::optional<std::string> output, checkpoint, restart;
+  std::optional<double> end_time;
+  bool quiet = false;
+  std::string progress = "auto";
+  CLI::App* run = app.add_subcommand("run", "Run a scene file: HDF5 + XDMF output, checkpoints");
+  run->add_option("scene", scene_file, "The scene file (TOML)")
+      ->required()
+      ->check(CLI::ExistingFile);
+  run->add_option("-o,--output", output, "The HDF5 output (default: [output] file of the scene)");
+  run->add_option("-c,--checkpoint", checkpoint,
+                  "Where checkpoints go (default: [checkpoint] file of the scene)");
+  run->add_option("-r,--restart", restart, "Continue from this checkpoint")
+      ->check(CLI::ExistingFile);
+  run->add_option("--end-time", end_time, "Run to this time [s] instead of the scene's end_time");
+  run->add_flag("-q,--quiet", quiet, "No progress and no summary; errors only");
+  run->add_option("--progress", progress,
+                  "auto (a bar on a terminal, else a line every 10 s), bar, lines")
+      ->check(CLI::IsMember({"auto", "bar", "lines"}));
+  run->footer(kExitCodes);
+
+  std::string validate_file;
+  CLI::App* validate =
+      app.add_subcommand("validate", "Check a scene file and summarise it without running it");
+  validate->add_option("scene", validate_file, "The scene file (TOML)")
+      ->required()
+      ->check(CLI::ExistingFile);
+  validate->footer(kExitCodes);
+
+  std::string info_file;
+  CLI::App* info = app.add_subcommand(
+      "info", "Summarise an output file: bodies, records, time range, solver statistics");
+  info->add_option("output", info_file, "The HDF5 output of grbd run")
+      ->required()
+      ->check(CLI::ExistingFile);
+  info->footer(kExitCodes);
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    const int code = app.exit(e);
+    return code == 0 ? 0 : kExitUsage;
+  }
+  if (run->parsed())
+    return run_command(scene_file, output, checkpoint, restart, end_time, quiet, progress);
+  if (validate->parsed()) return validate_command(validate_file);
+  if (info->parsed()) return info_command(info_file);
+  return kExitUsage;
+}

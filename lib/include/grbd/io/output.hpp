@@ -1,0 +1,123 @@
+#pragma once
+/// \file
+/// \brief The output of a run (chapter 7): one HDF5 file with the bodies' constants, a table of
+/// every step and records of q and u, and an XDMF file beside it that ParaView opens directly.
+///
+/// Layout (every name is in the chapter's table):
+/// - attributes of `/`: `format` ("grbd output"), `format_version`, `grbd_version`, `host`,
+///   `date` (UTC, ISO 8601), `scene_file`, `scene` (the scene's text), `precision`;
+/// - `/materials`: the material names, a material's id is its index;
+/// - `/bodies`: one row per body created (id, shape, radius, half extents, half length, mass,
+///   principal moments, material, fixed);
+/// - `/steps`: one row per step (time, contacts, iterations, residual, converged, energies,
+///   largest penetration, bodies, stage timings);
+/// - `/records/time`, `/records/step`, `/records/bodies`, and one group `/records/NNNNNN` per
+///   record with `id`, `I_r_S`, `p`, `I_v_S`, `K_omega` and `radius`, rows in ascending global id;
+///   the attribute `/records@count` is the number of complete records.
+///
+/// After every record the file is flushed and `count` is written last, so that a run killed at
+/// any moment leaves a file that opens and holds every record counted.
+
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "grbd/core/error.hpp"
+#include "grbd/scene/simulation.hpp"
+#include "grbd/timestep/stepper.hpp"
+
+namespace grbd::io {
+
+/// An output or checkpoint file that cannot be written or read: the message names the file and
+/// the dataset or attribute.
+class IoError : public Error {
+ public:
+  using Error::Error;
+};
+
+/// How much of an output file was written: rows of /records, /steps and /bodies. A checkpoint
+/// keeps it, so that a restart can drop what was written after the checkpoint.
+struct OutputPosition {
+  std::uint64_t records = 0;  ///< complete records
+  std::uint64_t steps = 0;    ///< rows of /steps
+  std::uint64_t bodies = 0;   ///< rows of /bodies
+};
+
+/// The format version written to and required from output files.
+inline constexpr std::uint64_t kOutputFormatVersion = 1;
+
+/// The output file of a run. Steps are buffered and written with each record (or flush()).
+class OutputFile {
+ public:
+  /// Creates `path` (replacing a file of that name) and the XDMF file beside it (`.xmf`).
+  OutputFile(const std::filesystem::path& path, const scene::Scene& scene);
+  /// Reopens the output of an earlier run for a restart: keeps what `at` counts and drops the
+  /// rest (records, steps and bodies written after the checkpoint). Throws IoError when the file
+  /// is not a grbd output or holds less than `at`.
+  OutputFile(const std::filesystem::path& path, const scene::Scene& scene,
+             const OutputPosition& at);
+  ~OutputFile();
+  OutputFile(const OutputFile&) = delete;
+  OutputFile& operator=(const OutputFile&) = delete;
+
+  /// Buffers the row of one step.
+  void add_step(const timestep::StepReport& report, std::size_t bodies);
+  /// Writes the bodies created since the last call, the buffered steps and a record of every
+  /// body's q and u (rows sorted by id); flushes, then counts the record; rewrites the XDMF.
+  void write_record(scene::Simulation& simulation);
+  /// Writes the bodies created and the buffered steps, and flushes (before a checkpoint).
+  void flush(scene::Simulation& simulation);
+  /// What has been written (after flush(): everything so far).
+  OutputPosition position() const { return written_; }
+  /// Flushes and closes; throws IoError if HDF5 cannot. The destructor closes silently.
+  void close(scene::Simulation& simulation);
+  /// The XDMF file written beside `path`.
+  static std::filesystem::path xdmf_path(const std::filesystem::path& path);
+
+ private:
+  struct Impl;
+  void write_bodies(scene::Simulation& simulation);
+  void write_steps();
+  void write_xdmf() const;
+  Impl* impl_;
+  OutputPosition written_;
+};
+
+/// What `grbd info` says about an output file.
+struct OutputSummary {
+  std::string scene_file;            ///< attribute scene_file
+  std::string grbd_version;          ///< attribute grbd_version
+  std::string date;                  ///< attribute date
+  std::string host;                  ///< attribute host
+  std::string precision;             ///< "double" or "float"
+  std::uint64_t bodies = 0;          ///< rows of /bodies
+  std::uint64_t steps = 0;           ///< rows of /steps
+  std::uint64_t records = 0;         ///< complete records
+  double t_first = 0.0;              ///< time of the first record [s]
+  double t_last = 0.0;               ///< time of the last record [s]
+  std::uint64_t bodies_last = 0;     ///< bodies in the last record
+  std::uint64_t max_contacts = 0;    ///< over the steps
+  double mean_iterations = 0.0;      ///< over the steps
+  std::uint64_t max_iterations = 0;  ///< over the steps
+  std::uint64_t non_converged = 0;   ///< steps that did not converge
+  double max_penetration = 0.0;      ///< over the steps [m]
+  double seconds = 0.0;              ///< wall time of the steps [s]
+};
+
+/// Reads the summary of an output file (IoError naming the file and dataset when it is not one).
+OutputSummary read_summary(const std::filesystem::path& path);
+
+/// One record read back: the global ids and the states, rows in ascending id.
+struct Record {
+  double t = 0.0;                   ///< time [s]
+  std::uint64_t step = 0;           ///< step count
+  std::vector<std::uint64_t> id;    ///< global ids
+  std::vector<body::State> states;  ///< q and u (converted to double)
+  std::vector<double> radius;       ///< bounding radius of each body [m]
+};
+
+/// Reads record `index` (< records) of an output file.
+Record read_record(const std::filesystem::path& path, std::uint64_t index);
+
+}  // namespace grbd::io

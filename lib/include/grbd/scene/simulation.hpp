@@ -1,0 +1,122 @@
+#pragma once
+/// \file
+/// \brief A scene made runnable (chapter 7): the materials, the static geometry, the bodies from
+/// the generators (lattice, packing, inflow) and chapter 6's stepper, with the state a checkpoint
+/// must keep to continue a run bit for bit.
+
+#include <cstdint>
+#include <optional>
+#include <span>
+#include <vector>
+
+#include "grbd/scene/scene.hpp"
+#include "grbd/timestep/body_system.hpp"
+#include "grbd/timestep/materials.hpp"
+#include "grbd/timestep/stepper.hpp"
+
+namespace grbd::scene {
+
+/// What never changes about a body: its identity, shape, inertia and material. With its state it
+/// is the body; the output writes one row of these per body created, a checkpoint one per body.
+struct BodyConstants {
+  timestep::GlobalId id = 0;                                  ///< stable global id
+  collision::ShapeKind shape = collision::ShapeKind::sphere;  ///< sphere, box or capsule
+  double radius = 0.0;                     ///< sphere, capsule: radius [m]; box: 0
+  Vector3 half_extents = Vector3::Zero();  ///< box [m]; else 0
+  double half_length = 0.0;                ///< capsule [m]; else 0
+  body::RigidBody inertia;                 ///< m, K_Theta
+  timestep::MaterialId material = 0;       ///< row of the material table
+  bool fixed = false;                      ///< never moves
+};
+
+/// The collision shape of a body.
+collision::Shape shape_of(const BodyConstants& body);
+
+/// What a generator has done so far: enough to continue it exactly.
+struct GeneratorState {
+  std::uint64_t random = 0;   ///< state of its Random
+  std::uint64_t created = 0;  ///< bodies it created so far
+};
+
+/// Everything the next step depends on (what a checkpoint holds, chapter 7).
+struct SimulationState {
+  double t = 0.0;                               ///< time [s]
+  std::uint64_t steps = 0;                      ///< steps done
+  std::uint64_t next_id = 0;                    ///< the global id of the next body created
+  std::uint64_t removed = 0;                    ///< bodies removed by the outlet so far
+  std::vector<BodyConstants> bodies;            ///< in the system's order
+  std::vector<body::State> states;              ///< their states
+  std::vector<timestep::ContactKey> warm_keys;  ///< the stepper's warm starts
+  std::vector<Vector3> warm_lambda;             ///< their percussions
+  std::vector<GeneratorState> generators;       ///< one per body group
+};
+
+/// A runnable scene. Construction generates the initial bodies (list, lattice and packing
+/// groups) and checks everything the stepper checks (materials of every pair, supported shape
+/// pairs); a scene that cannot run throws SceneError before the first step.
+class Simulation {
+ public:
+  /// Builds the scene and its initial bodies.
+  explicit Simulation(const Scene& scene);
+  /// Builds the scene and continues from `state` instead (restart); throws SceneError when the
+  /// state does not fit the scene (a material or group it does not have).
+  Simulation(const Scene& scene, const SimulationState& state);
+  Simulation(const Simulation&) = delete;
+  Simulation& operator=(const Simulation&) = delete;
+
+  /// One step: inflow generators add their bodies, the stepper steps, the outlet removes the
+  /// bodies that left the domain.
+  timestep::StepReport step();
+  /// True when the scene's number of steps is done.
+  bool finished() const { return stepper_->steps() >= scene_.steps(); }
+
+  /// Everything the next step depends on.
+  SimulationState save() const;
+
+  /// \name Parts
+  ///@{
+  const Scene& scene() const { return scene_; }                            ///< the scene
+  const timestep::BodySystem& system() const { return system_; }           ///< the bodies
+  const timestep::StaticGeometry& statics() const { return statics_; }     ///< static geometry
+  const timestep::MaterialTable& materials() const { return materials_; }  ///< materials
+  timestep::MoreauStepper& stepper() { return *stepper_; }                 ///< the stepper
+  const timestep::MoreauStepper& stepper() const { return *stepper_; }     ///< the stepper
+  ///@}
+  /// The constants of the body with local index i (from the system's arrays).
+  BodyConstants constants(std::size_t i) const;
+  /// Bodies created since the caller last emptied this list (their constants), for the output.
+  std::vector<BodyConstants>& created() { return created_; }
+  /// Bodies created so far (all groups) and removed by the outlet.
+  std::uint64_t bodies_created() const { return next_id_; }
+  std::uint64_t bodies_removed() const { return removed_; }  ///< by the outlet
+  /// Bodies an inflow generator owed but could not place (the region was full) at the last step.
+  std::uint64_t inflow_backlog() const { return backlog_; }
+
+ private:
+  Simulation(const Scene& scene, const SimulationState* state);
+  void restore(const SimulationState& state);
+  void build_static();
+  void generate_initial();
+  void add_body(const BodyConstants& constants, const body::State& state);
+  void inflow();
+  void outlet();
+  void check_shapes() const;
+  BodyConstants make_constants(std::size_t group, Random& random);
+
+  const Scene& scene_;
+  timestep::MaterialTable materials_;
+  timestep::StaticGeometry statics_;
+  timestep::BodySystem system_;
+  std::optional<timestep::MoreauStepper> stepper_;
+  std::vector<BodyConstants> created_;
+  std::vector<GeneratorState> generators_;
+  std::uint64_t next_id_ = 0;
+  std::uint64_t removed_ = 0;
+  std::uint64_t backlog_ = 0;
+  std::vector<std::size_t> leaving_;
+};
+
+/// The radius of the sphere about S that holds a body of a group, at its largest [m].
+double largest_bounding_radius(const BodyGroup& group);
+
+}  // namespace grbd::scene

@@ -1,0 +1,245 @@
+// Helpers over HDF5's C API for the output and checkpoint files.
+
+#include "io/h5util.hpp"
+
+#include <cstddef>
+#include <limits>
+
+namespace grbd::io::h5 {
+
+Handle body_row_type() {
+  Handle type(H5Tcreate(H5T_COMPOUND, sizeof(BodyRow)), H5Tclose);
+  const hsize_t three = 3;
+  Handle vector3(H5Tarray_create2(H5T_NATIVE_DOUBLE, 1, &three), H5Tclose);
+  H5Tinsert(type.get(), "id", HOFFSET(BodyRow, id), H5T_NATIVE_UINT64);
+  H5Tinsert(type.get(), "shape", HOFFSET(BodyRow, shape), H5T_NATIVE_UINT8);
+  H5Tinsert(type.get(), "fixed", HOFFSET(BodyRow, fixed), H5T_NATIVE_UINT8);
+  H5Tinsert(type.get(), "material", HOFFSET(BodyRow, material), H5T_NATIVE_UINT32);
+  H5Tinsert(type.get(), "radius", HOFFSET(BodyRow, radius), H5T_NATIVE_DOUBLE);
+  H5Tinsert(type.get(), "half_extents", HOFFSET(BodyRow, half_extents), vector3.get());
+  H5Tinsert(type.get(), "half_length", HOFFSET(BodyRow, half_length), H5T_NATIVE_DOUBLE);
+  H5Tinsert(type.get(), "mass", HOFFSET(BodyRow, mass), H5T_NATIVE_DOUBLE);
+  H5Tinsert(type.get(), "K_Theta", HOFFSET(BodyRow, K_Theta), vector3.get());
+  return type;
+}
+
+Handle step_row_type() {
+  Handle type(H5Tcreate(H5T_COMPOUND, sizeof(StepRow)), H5Tclose);
+  H5Tinsert(type.get(), "step", HOFFSET(StepRow, step), H5T_NATIVE_UINT64);
+  H5Tinsert(type.get(), "t", HOFFSET(StepRow, t), H5T_NATIVE_DOUBLE);
+  H5Tinsert(type.get(), "bodies", HOFFSET(StepRow, bodies), H5T_NATIVE_UINT64);
+  H5Tinsert(type.get(), "contacts", HOFFSET(StepRow, contacts), H5T_NATIVE_UINT64);
+  H5Tinsert(type.get(), "warm_started", HOFFSET(StepRow, warm_started), H5T_NATIVE_UINT64);
+  H5Tinsert(type.get(), "iterations", HOFFSET(StepRow, iterations), H5T_NATIVE_INT32);
+  H5Tinsert(type.get(), "converged", HOFFSET(StepRow, converged), H5T_NATIVE_UINT8);
+  H5Tinsert(type.get(), "residual", HOFFSET(StepRow, residual), H5T_NATIVE_DOUBLE);
+  H5Tinsert(type.get(), "kinetic_energy", HOFFSET(StepRow, kinetic_energy), H5T_NATIVE_DOUBLE);
+  H5Tinsert(type.get(), "potential_energy", HOFFSET(StepRow, potential_energy), H5T_NATIVE_DOUBLE);
+  H5Tinsert(type.get(), "max_penetration", HOFFSET(StepRow, max_penetration), H5T_NATIVE_DOUBLE);
+  H5Tinsert(type.get(), "seconds_midpoint", HOFFSET(StepRow, seconds_midpoint), H5T_NATIVE_DOUBLE);
+  H5Tinsert(type.get(), "seconds_detection", HOFFSET(StepRow, seconds_detection),
+            H5T_NATIVE_DOUBLE);
+  H5Tinsert(type.get(), "seconds_assembly", HOFFSET(StepRow, seconds_assembly), H5T_NATIVE_DOUBLE);
+  H5Tinsert(type.get(), "seconds_solve", HOFFSET(StepRow, seconds_solve), H5T_NATIVE_DOUBLE);
+  H5Tinsert(type.get(), "seconds_update", HOFFSET(StepRow, seconds_update), H5T_NATIVE_DOUBLE);
+  H5Tinsert(type.get(), "seconds_total", HOFFSET(StepRow, seconds_total), H5T_NATIVE_DOUBLE);
+  return type;
+}
+
+Handle packed(hid_t type) {
+  Handle copy(H5Tcopy(type), H5Tclose);
+  H5Tpack(copy.get());
+  return copy;
+}
+
+namespace {
+
+void write_scalar_attribute(hid_t object, const char* name, hid_t file_type, hid_t memory_type,
+                            const void* value, const std::string& file) {
+  if (H5Aexists(object, name) > 0)
+    check(H5Adelete(object, name), file, std::string("cannot replace attribute ") + name);
+  Handle space = check(H5Screate(H5S_SCALAR), H5Sclose, file, "cannot create a dataspace");
+  Handle attribute =
+      check(H5Acreate2(object, name, file_type, space.get(), H5P_DEFAULT, H5P_DEFAULT), H5Aclose,
+            file, std::string("cannot create attribute ") + name);
+  check(H5Awrite(attribute.get(), memory_type, value), file,
+        std::string("cannot write attribute ") + name);
+}
+
+Handle open_attribute(hid_t object, const char* name, const std::string& file) {
+  if (H5Aexists(object, name) <= 0) fail(file, std::string("attribute ") + name + " is missing");
+  return check(H5Aopen(object, name, H5P_DEFAULT), H5Aclose, file,
+               std::string("cannot open attribute ") + name);
+}
+
+}  // namespace
+
+void write_attribute(hid_t object, const char* name, double value, const std::string& file) {
+  write_scalar_attribute(object, name, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, &value, file);
+}
+
+void write_attribute(hid_t object, const char* name, std::uint64_t value, const std::string& file) {
+  write_scalar_attribute(object, name, H5T_STD_U64LE, H5T_NATIVE_UINT64, &value, file);
+}
+
+void write_attribute(hid_t object, const char* name, const std::string& value,
+                     const std::string& file) {
+  Handle type = check(H5Tcopy(H5T_C_S1), H5Tclose, file, "cannot create a string type");
+  H5Tset_size(type.get(), H5T_VARIABLE);
+  H5Tset_cset(type.get(), H5T_CSET_UTF8);
+  const char* text = value.c_str();
+  write_scalar_attribute(object, name, type.get(), type.get(), &text, file);
+}
+
+double read_double(hid_t object, const char* name, const std::string& file) {
+  Handle attribute = open_attribute(object, name, file);
+  Handle space = check(H5Aget_space(attribute.get()), H5Sclose, file, "cannot read a dataspace");
+  if (H5Sget_simple_extent_npoints(space.get()) != 1)
+    fail(file, std::string("attribute ") + name + " is not a scalar");
+  double value = 0.0;
+  check(H5Aread(attribute.get(), H5T_NATIVE_DOUBLE, &value), file,
+        std::string("attribute ") + name + " is not a number");
+  return value;
+}
+
+std::uint64_t read_uint(hid_t object, const char* name, const std::string& file) {
+  Handle attribute = open_attribute(object, name, file);
+  Handle type = check(H5Aget_type(attribute.get()), H5Tclose, file, "cannot read a type");
+  if (H5Tget_class(type.get()) != H5T_INTEGER)
+    fail(file, std::string("attribute ") + name + " is not an integer");
+  Handle space = check(H5Aget_space(attribute.get()), H5Sclose, file, "cannot read a dataspace");
+  if (H5Sget_simple_extent_npoints(space.get()) != 1)
+    fail(file, std::string("attribute ") + name + " is not a scalar");
+  std::uint64_t value = 0;
+  check(H5Aread(attribute.get(), H5T_NATIVE_UINT64, &value), file,
+        std::string("attribute ") + name + " is not an unsigned integer");
+  return value;
+}
+
+std::string read_string(hid_t object, const char* name, const std::string& file) {
+  Handle attribute = open_attribute(object, name, file);
+  Handle type = check(H5Aget_type(attribute.get()), H5Tclose, file, "cannot read a type");
+  Handle space = check(H5Aget_space(attribute.get()), H5Sclose, file, "cannot read a dataspace");
+  if (H5Tget_class(type.get()) != H5T_STRING || H5Tis_variable_str(type.get()) <= 0 ||
+      H5Sget_simple_extent_npoints(space.get()) != 1) {
+    fail(file, std::string("attribute ") + name + " is not a variable-length string");
+  }
+  Handle memory = check(H5Tcopy(H5T_C_S1), H5Tclose, file, "cannot create a string type");
+  H5Tset_size(memory.get(), H5T_VARIABLE);
+  H5Tset_cset(memory.get(), H5Tget_cset(type.get()));
+  char* text = nullptr;
+  check(H5Aread(attribute.get(), memory.get(), &text), file,
+        std::string("cannot read attribute ") + name);
+  std::string value = text != nullptr ? text : "";
+  H5free_memory(text);
+  return value;
+}
+
+Handle create_table(hid_t location, const char* name, hid_t type, hsize_t chunk,
+                    const std::string& file) {
+  const hsize_t zero = 0;
+  const hsize_t unlimited = H5S_UNLIMITED;
+  Handle space =
+      check(H5Screate_simple(1, &zero, &unlimited), H5Sclose, file, "cannot create a dataspace");
+  Handle properties =
+      check(H5Pcreate(H5P_DATASET_CREATE), H5Pclose, file, "cannot create a property list");
+  check(H5Pset_chunk(properties.get(), 1, &chunk), file, "cannot set a chunk size");
+  return check(
+      H5Dcreate2(location, name, type, space.get(), H5P_DEFAULT, properties.get(), H5P_DEFAULT),
+      H5Dclose, file, std::string("cannot create dataset ") + name);
+}
+
+std::uint64_t rows(hid_t dataset, const std::string& file, const std::string& name) {
+  Handle space = check(H5Dget_space(dataset), H5Sclose, file, "cannot read the shape of " + name);
+  if (H5Sget_simple_extent_ndims(space.get()) != 1) fail(file, name + " is not one-dimensional");
+  hsize_t n = 0;
+  H5Sget_simple_extent_dims(space.get(), &n, nullptr);
+  return n;
+}
+
+void resize(hid_t dataset, std::uint64_t n, const std::string& file, const std::string& name) {
+  const hsize_t size = n;
+  check(H5Dset_extent(dataset, &size), file, "cannot resize " + name);
+}
+
+void append(hid_t dataset, hid_t memory_type, const void* data, std::uint64_t n,
+            const std::string& file, const std::string& name) {
+  if (n == 0) return;
+  const std::uint64_t old = rows(dataset, file, name);
+  resize(dataset, old + n, file, name);
+  Handle space = check(H5Dget_space(dataset), H5Sclose, file, "cannot read the shape of " + name);
+  const hsize_t start = old;
+  const hsize_t count = n;
+  check(H5Sselect_hyperslab(space.get(), H5S_SELECT_SET, &start, nullptr, &count, nullptr), file,
+        "cannot select rows of " + name);
+  Handle memory =
+      check(H5Screate_simple(1, &count, nullptr), H5Sclose, file, "cannot create a dataspace");
+  check(H5Dwrite(dataset, memory_type, memory.get(), space.get(), H5P_DEFAULT, data), file,
+        "cannot write " + name);
+}
+
+void write_array(hid_t location, const char* name, hid_t file_type, hid_t memory_type,
+                 std::uint64_t rows, std::uint64_t cols, const void* data,
+                 const std::string& file) {
+  const hsize_t dims[2] = {rows, cols};
+  Handle space = check(H5Screate_simple(cols == 0 ? 1 : 2, dims, nullptr), H5Sclose, file,
+                       "cannot create a dataspace");
+  Handle dataset = check(
+      H5Dcreate2(location, name, file_type, space.get(), H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT),
+      H5Dclose, file, std::string("cannot create dataset ") + name);
+  if (rows > 0) {
+    check(H5Dwrite(dataset.get(), memory_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, data), file,
+          std::string("cannot write dataset ") + name);
+  }
+}
+
+template <class T>
+std::uint64_t read_array(hid_t location, const char* name, hid_t memory_type, std::int64_t rows,
+                         std::uint64_t cols, std::vector<T>& data, const std::string& file) {
+  if (H5Lexists(location, name, H5P_DEFAULT) <= 0)
+    fail(file, std::string("dataset ") + name + " is missing");
+  Handle dataset = check(H5Dopen2(location, name, H5P_DEFAULT), H5Dclose, file,
+                         std::string("cannot open dataset ") + name);
+  Handle space = check(H5Dget_space(dataset.get()), H5Sclose, file,
+                       std::string("cannot read the shape of ") + name);
+  const int rank = H5Sget_simple_extent_ndims(space.get());
+  hsize_t dims[2] = {0, 0};
+  const int expected_rank = cols == 0 ? 1 : 2;
+  if (rank != expected_rank) {
+    fail(file, std::string("dataset ") + name + ": expected " + std::to_string(expected_rank) +
+                   " dimension(s), found " + std::to_string(rank));
+  }
+  H5Sget_simple_extent_dims(space.get(), dims, nullptr);
+  if ((rows >= 0 && dims[0] != static_cast<hsize_t>(rows)) || (cols != 0 && dims[1] != cols)) {
+    fail(file, std::string("dataset ") + name + ": expected " +
+                   (rows >= 0 ? std::to_string(rows) : std::string("n")) +
+                   (cols != 0 ? " × " + std::to_string(cols) : std::string()) +
+                   " elements, found " + std::to_string(dims[0]) +
+                   (cols != 0 ? " × " + std::to_string(dims[1]) : std::string()));
+  }
+  const std::uint64_t per_row = cols == 0 ? 1 : cols;
+  const std::uint64_t elements = dims[0] * per_row;
+  // The file cannot hold more elements than it has bytes (a forged header must not allocate).
+  const hsize_t storage = H5Dget_storage_size(dataset.get());
+  if (elements > 0 && storage / H5Tget_size(memory_type) < elements / 16) {
+    fail(file, std::string("dataset ") + name + " declares more elements than it stores");
+  }
+  data.resize(elements);
+  if (elements > 0) {
+    check(H5Dread(dataset.get(), memory_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, data.data()), file,
+          std::string("cannot read dataset ") + name + " as the expected type");
+  }
+  return dims[0];
+}
+
+template std::uint64_t read_array<double>(hid_t, const char*, hid_t, std::int64_t, std::uint64_t,
+                                          std::vector<double>&, const std::string&);
+template std::uint64_t read_array<std::uint64_t>(hid_t, const char*, hid_t, std::int64_t,
+                                                 std::uint64_t, std::vector<std::uint64_t>&,
+                                                 const std::string&);
+template std::uint64_t read_array<BodyRow>(hid_t, const char*, hid_t, std::int64_t, std::uint64_t,
+                                           std::vector<BodyRow>&, const std::string&);
+template std::uint64_t read_array<StepRow>(hid_t, const char*, hid_t, std::int64_t, std::uint64_t,
+                                           std::vector<StepRow>&, const std::string&);
+
+}  // namespace grbd::io::h5

@@ -1,0 +1,100 @@
+#pragma once
+// Small helpers over HDF5's C API for the output and checkpoint files (private to the library).
+// Every failure throws io::IoError naming the file and the object.
+
+#include <hdf5.h>
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "core/hdf5.hpp"
+#include "grbd/io/output.hpp"
+
+namespace grbd::io::h5 {
+
+using hdf5::Handle;
+
+[[noreturn]] inline void fail(const std::string& file, const std::string& what) {
+  throw IoError(file + ": " + what + hdf5::message());
+}
+
+inline Handle check(hid_t id, Handle::Close close, const std::string& file,
+                    const std::string& what) {
+  if (id < 0) fail(file, what);
+  return Handle(id, close);
+}
+
+inline void check(herr_t status, const std::string& file, const std::string& what) {
+  if (status < 0) fail(file, what);
+}
+
+/// One row of /bodies (output) and of a checkpoint's /bodies.
+struct BodyRow {
+  std::uint64_t id;
+  std::uint8_t shape;  // 0 sphere, 1 box, 2 capsule (collision::ShapeKind)
+  std::uint8_t fixed;
+  std::uint32_t material;
+  double radius;
+  double half_extents[3];
+  double half_length;
+  double mass;
+  double K_Theta[3];
+};
+
+/// One row of /steps.
+struct StepRow {
+  std::uint64_t step;
+  double t;
+  std::uint64_t bodies;
+  std::uint64_t contacts;
+  std::uint64_t warm_started;
+  std::int32_t iterations;
+  std::uint8_t converged;
+  double residual;
+  double kinetic_energy;
+  double potential_energy;
+  double max_penetration;
+  double seconds_midpoint;
+  double seconds_detection;
+  double seconds_assembly;
+  double seconds_solve;
+  double seconds_update;
+  double seconds_total;
+};
+
+/// The compound types of the rows in memory (with the struct's padding).
+Handle body_row_type();
+Handle step_row_type();
+/// A packed copy of a compound type: what goes into the file, without padding bytes.
+Handle packed(hid_t type);
+
+void write_attribute(hid_t object, const char* name, double value, const std::string& file);
+void write_attribute(hid_t object, const char* name, std::uint64_t value, const std::string& file);
+void write_attribute(hid_t object, const char* name, const std::string& value,
+                     const std::string& file);
+double read_double(hid_t object, const char* name, const std::string& file);
+std::uint64_t read_uint(hid_t object, const char* name, const std::string& file);
+std::string read_string(hid_t object, const char* name, const std::string& file);
+
+/// An extendable 1-D dataset of `type`, chunked by `chunk` rows.
+Handle create_table(hid_t location, const char* name, hid_t type, hsize_t chunk,
+                    const std::string& file);
+/// Rows of a 1-D dataset.
+std::uint64_t rows(hid_t dataset, const std::string& file, const std::string& name);
+/// Appends n rows of `memory_type`.
+void append(hid_t dataset, hid_t memory_type, const void* data, std::uint64_t n,
+            const std::string& file, const std::string& name);
+/// Sets the rows of a 1-D extendable dataset.
+void resize(hid_t dataset, std::uint64_t n, const std::string& file, const std::string& name);
+
+/// Writes a contiguous dataset of rows × cols (cols = 0: a 1-D dataset of `rows`).
+void write_array(hid_t location, const char* name, hid_t file_type, hid_t memory_type,
+                 std::uint64_t rows, std::uint64_t cols, const void* data, const std::string& file);
+/// Reads a dataset that must be rows × cols (cols = 0: 1-D; rows = -1: any number of rows, which
+/// is returned) into `data`, resized to fit.
+template <class T>
+std::uint64_t read_array(hid_t location, const char* name, hid_t memory_type, std::int64_t rows,
+                         std::uint64_t cols, std::vector<T>& data, const std::string& file);
+
+}  // namespace grbd::io::h5

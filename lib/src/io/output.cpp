@@ -1,0 +1,521 @@
+// The output of a run (chapter 7): HDF5 with an XDMF description beside it.
+
+#include "grbd/io/output.hpp"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <ctime>
+#include <fstream>
+#include <numeric>
+#include <sstream>
+
+#include "io/h5util.hpp"
+
+#ifndef GRBD_VERSION
+#define GRBD_VERSION "unknown"
+#endif
+
+namespace grbd::io {
+
+namespace {
+
+using h5::check;
+using h5::Handle;
+
+std::string record_name(std::uint64_t index) {
+  char name[32];
+  std::snprintf(name, sizeof(name), "%06llu", static_cast<unsigned long long>(index));
+  return name;
+}
+
+std::string utc_now() {
+  const std::time_t now = std::chrono::system_clock::to_time_t(std::chrono::system_clock::now());
+  std::tm tm{};
+  gmtime_r(&now, &tm);
+  char text[32];
+  std::strftime(text, sizeof(text), "%Y-%m-%dT%H:%M:%SZ", &tm);
+  return text;
+}
+
+std::string host_name() {
+  char name[256] = {};
+  if (gethostname(name, sizeof(name) - 1) != 0) return "unknown";
+  return name;
+}
+
+// Writes `text` to `path` atomically (temporary file, then rename).
+void write_file_atomically(const std::filesystem::path& path, const std::string& text) {
+  const std::filesystem::path temporary = path.string() + ".tmp";
+  {
+    std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
+    out << text;
+    out.flush();
+    if (!out) throw IoError(temporary.string() + ": cannot write the XDMF file");
+  }
+  std::error_code error;
+  std::filesystem::rename(temporary, path, error);
+  if (error)
+    throw IoError(path.string() + ": cannot rename the XDMF file into place: " + error.message());
+}
+
+Handle open_dataset(hid_t location, const char* name, const std::string& file) {
+  if (H5Lexists(location, name, H5P_DEFAULT) <= 0)
+    h5::fail(file, std::string("dataset ") + name + " is missing");
+  return check(H5Dopen2(location, name, H5P_DEFAULT), H5Dclose, file,
+               std::string("cannot open dataset ") + name);
+}
+
+Handle open_group(hid_t location, const char* name, const std::string& file) {
+  if (H5Lexists(location, name, H5P_DEFAULT) <= 0)
+    h5::fail(file, std::string("group ") + name + " is missing");
+  return check(H5Gopen2(location, name, H5P_DEFAULT), H5Gclose, file,
+               std::string("cannot open group ") + name);
+}
+
+// Opens an output file, checking that it is one (IoError naming it when not).
+Handle open_output(const std::filesystem::path& path, unsigned mode) {
+  const std::string file = path.string();
+  std::error_code error;
+  if (!std::filesystem::is_regular_file(path, error)) h5::fail(file, "no such file");
+  if (H5Fis_hdf5(file.c_str()) <= 0) h5::fail(file, "is not an HDF5 file");
+  Handle handle = check(H5Fopen(file.c_str(), mode, H5P_DEFAULT), H5Fclose, file,
+                        "cannot open the file (it may be damaged)");
+  if (H5Aexists(handle.get(), "format") <= 0 ||
+      h5::read_string(handle.get(), "format", file) != "grbd output") {
+    h5::fail(file, "is not a grbd output file (attribute format is not \"grbd output\")");
+  }
+  const std::uint64_t version = h5::read_uint(handle.get(), "format_version", file);
+  if (version != kOutputFormatVersion) {
+    h5::fail(file, "format_version " + std::to_string(version) + ", this grbd reads version " +
+                       std::to_string(kOutputFormatVersion));
+  }
+  return handle;
+}
+
+}  // namespace
+
+struct OutputFile::Impl {
+  std::filesystem::path path;
+  std::string file;
+  bool float32 = false;
+  Handle handle;
+  Handle bodies;
+  Handle steps;
+  Handle records;
+  Handle record_time;
+  Handle record_step;
+  Handle record_bodies;
+  Handle body_type = h5::body_row_type();
+  Handle step_type = h5::step_row_type();
+  std::vector<h5::StepRow> pending_steps;
+  // What the XDMF lists: time and body count of each complete record.
+  std::vector<double> times;
+  std::vector<std::uint64_t> counts;
+  // Scratch of a record.
+  std::vector<std::size_t> order;
+  std::vector<std::uint64_t> ids;
+  std::vector<double> r, p, v, w, radius;
+};
+
+std::filesystem::path OutputFile::xdmf_path(const std::filesystem::path& path) {
+  std::filesystem::path xdmf = path;
+  xdmf.replace_extension(".xmf");
+  return xdmf;
+}
+
+OutputFile::OutputFile(const std::filesystem::path& path, const scene::Scene& scene)
+    : impl_(new Impl) {
+  std::lock_guard lock(hdf5::mutex());
+  hdf5::QuietErrors quiet;
+  Impl& o = *impl_;
+  o.path = path;
+  o.file = path.string();
+  o.float32 = scene.output.float32;
+  try {
+    o.handle = check(H5Fcreate(o.file.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT), H5Fclose,
+                     o.file, "cannot create the output file");
+    const hid_t root = o.handle.get();
+    h5::write_attribute(root, "format", std::string("grbd output"), o.file);
+    h5::write_attribute(root, "format_version", kOutputFormatVersion, o.file);
+    h5::write_attribute(root, "grbd_version", std::string(GRBD_VERSION), o.file);
+    h5::write_attribute(root, "host", host_name(), o.file);
+    h5::write_attribute(root, "date", utc_now(), o.file);
+    h5::write_attribute(root, "scene_file", scene.file.string(), o.file);
+    h5::write_attribute(root, "scene", scene.text, o.file);
+    h5::write_attribute(root, "precision", std::string(o.float32 ? "float" : "double"), o.file);
+    h5::write_attribute(root, "dt", scene.settings.dt, o.file);
+    {
+      Handle type = check(H5Tcopy(H5T_C_S1), H5Tclose, o.file, "cannot create a string type");
+      H5Tset_size(type.get(), H5T_VARIABLE);
+      H5Tset_cset(type.get(), H5T_CSET_UTF8);
+      std::vector<const char*> names;
+      for (const std::string& m : scene.materials) names.push_back(m.c_str());
+      h5::write_array(root, "materials", type.get(), type.get(), names.size(), 0, names.data(),
+                      o.file);
+    }
+    o.bodies = h5::create_table(root, "bodies", h5::packed(o.body_type.get()).get(), 4096, o.file);
+    o.steps = h5::create_table(root, "steps", h5::packed(o.step_type.get()).get(), 1024, o.file);
+    o.records = check(H5Gcreate2(root, "records", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Gclose,
+                      o.file, "cannot create group records");
+    o.record_time = h5::create_table(o.records.get(), "time", H5T_IEEE_F64LE, 256, o.file);
+    o.record_step = h5::create_table(o.records.get(), "step", H5T_STD_U64LE, 256, o.file);
+    o.record_bodies = h5::create_table(o.records.get(), "bodies", H5T_STD_U64LE, 256, o.file);
+    h5::write_attribute(o.records.get(), "count", std::uint64_t{0}, o.file);
+    check(H5Fflush(root, H5F_SCOPE_LOCAL), o.file, "cannot flush");
+    write_xdmf();
+  } catch (...) {
+    delete impl_;
+    throw;
+  }
+}
+
+OutputFile::OutputFile(const std::filesystem::path& path, const scene::Scene& scene,
+                       const OutputPosition& at)
+    : impl_(new Impl) {
+  std::lock_guard lock(hdf5::mutex());
+  hdf5::QuietErrors quiet;
+  Impl& o = *impl_;
+  o.path = path;
+  o.file = path.string();
+  try {
+    o.handle = open_output(path, H5F_ACC_RDWR);
+    const hid_t root = o.handle.get();
+    o.float32 = h5::read_string(root, "precision", o.file) == "float";
+    if (o.float32 != scene.output.float32) {
+      h5::fail(o.file, "was written in " + std::string(o.float32 ? "float" : "double") +
+                           " precision, the scene asks for the other");
+    }
+    o.bodies = open_dataset(root, "bodies", o.file);
+    o.steps = open_dataset(root, "steps", o.file);
+    o.records = open_group(root, "records", o.file);
+    o.record_time = open_dataset(o.records.get(), "time", o.file);
+    o.record_step = open_dataset(o.records.get(), "step", o.file);
+    o.record_bodies = open_dataset(o.records.get(), "bodies", o.file);
+    const std::uint64_t count = h5::read_uint(o.records.get(), "count", o.file);
+    if (count < at.records || h5::rows(o.steps.get(), o.file, "steps") < at.steps ||
+        h5::rows(o.bodies.get(), o.file, "bodies") < at.bodies ||
+        h5::rows(o.record_time.get(), o.file, "records/time") < at.records) {
+      h5::fail(o.file, "holds less than the checkpoint counts (" + std::to_string(at.records) +
+                           " records, " + std::to_string(at.steps) + " steps, " +
+                           std::to_string(at.bodies) + " bodies): it is not this run's output");
+    }
+    // Drop what follows the checkpoint: it is written again.
+    for (std::uint64_t k = at.records;; ++k) {
+      const std::string name = record_name(k);
+      if (H5Lexists(o.records.get(), name.c_str(), H5P_DEFAULT) <= 0) break;
+      check(H5Ldelete(o.records.get(), name.c_str(), H5P_DEFAULT), o.file,
+            "cannot delete record " + name);
+    }
+    h5::write_attribute(o.records.get(), "count", at.records, o.file);
+    h5::resize(o.record_time.get(), at.records, o.file, "records/time");
+    h5::resize(o.record_step.get(), at.records, o.file, "records/step");
+    h5::resize(o.record_bodies.get(), at.records, o.file, "records/bodies");
+    h5::resize(o.steps.get(), at.steps, o.file, "steps");
+    h5::resize(o.bodies.get(), at.bodies, o.file, "bodies");
+    h5::read_array(o.records.get(), "time", H5T_NATIVE_DOUBLE,
+                   static_cast<std::int64_t>(at.records), 0, o.times, o.file);
+    h5::read_array(o.records.get(), "bodies", H5T_NATIVE_UINT64,
+                   static_cast<std::int64_t>(at.records), 0, o.counts, o.file);
+    check(H5Fflush(root, H5F_SCOPE_LOCAL), o.file, "cannot flush");
+    written_ = at;
+    write_xdmf();
+  } catch (...) {
+    delete impl_;
+    throw;
+  }
+}
+
+OutputFile::~OutputFile() {
+  std::lock_guard lock(hdf5::mutex());
+  hdf5::QuietErrors quiet;
+  delete impl_;
+}
+
+void OutputFile::add_step(const timestep::StepReport& report, std::size_t bodies) {
+  h5::StepRow row{};
+  row.step = report.step;
+  row.t = report.t;
+  row.bodies = bodies;
+  row.contacts = report.contacts;
+  row.warm_started = report.warm_started;
+  row.iterations = report.iterations;
+  row.converged = report.converged ? 1 : 0;
+  row.residual = report.residual;
+  row.kinetic_energy = report.kinetic_energy;
+  row.potential_energy = report.potential_energy;
+  row.max_penetration = report.max_penetration;
+  row.seconds_midpoint = report.seconds.midpoint;
+  row.seconds_detection = report.seconds.detection;
+  row.seconds_assembly = report.seconds.assembly;
+  row.seconds_solve = report.seconds.solve;
+  row.seconds_update = report.seconds.update;
+  row.seconds_total = report.seconds.total;
+  impl_->pending_steps.push_back(row);
+}
+
+void OutputFile::write_bodies(scene::Simulation& simulation) {
+  Impl& o = *impl_;
+  std::vector<scene::BodyConstants>& created = simulation.created();
+  if (created.empty()) return;
+  std::vector<h5::BodyRow> rows(created.size());
+  for (std::size_t k = 0; k < created.size(); ++k) {
+    const scene::BodyConstants& c = created[k];
+    h5::BodyRow& row = rows[k];
+    row.id = c.id;
+    row.shape = static_cast<std::uint8_t>(c.shape);
+    row.fixed = c.fixed ? 1 : 0;
+    row.material = c.material;
+    row.radius = c.radius;
+    for (int d = 0; d < 3; ++d) {
+      row.half_extents[d] = c.half_extents[d];
+      row.K_Theta[d] = c.inertia.K_Theta[d];
+    }
+    row.half_length = c.half_length;
+    row.mass = c.inertia.m;
+  }
+  h5::append(o.bodies.get(), o.body_type.get(), rows.data(), rows.size(), o.file, "bodies");
+  written_.bodies += rows.size();
+  created.clear();
+}
+
+void OutputFile::write_steps() {
+  Impl& o = *impl_;
+  h5::append(o.steps.get(), o.step_type.get(), o.pending_steps.data(), o.pending_steps.size(),
+             o.file, "steps");
+  written_.steps += o.pending_steps.size();
+  o.pending_steps.clear();
+}
+
+void OutputFile::flush(scene::Simulation& simulation) {
+  std::lock_guard lock(hdf5::mutex());
+  hdf5::QuietErrors quiet;
+  write_bodies(simulation);
+  write_steps();
+  check(H5Fflush(impl_->handle.get(), H5F_SCOPE_LOCAL), impl_->file, "cannot flush");
+}
+
+void OutputFile::write_record(scene::Simulation& simulation) {
+  std::lock_guard lock(hdf5::mutex());
+  hdf5::QuietErrors quiet;
+  Impl& o = *impl_;
+  write_bodies(simulation);
+  write_steps();
+
+  const timestep::BodySystem& system = simulation.system();
+  const std::size_t n = system.size();
+  const auto ids = system.ids();
+  const auto states = system.states();
+  o.order.resize(n);
+  std::iota(o.order.begin(), o.order.end(), std::size_t{0});
+  std::sort(o.order.begin(), o.order.end(),
+            [&](std::size_t a, std::size_t b) { return ids[a] < ids[b]; });
+  o.ids.resize(n);
+  o.r.resize(3 * n);
+  o.p.resize(4 * n);
+  o.v.resize(3 * n);
+  o.w.resize(3 * n);
+  o.radius.resize(n);
+  for (std::size_t k = 0; k < n; ++k) {
+    const std::size_t i = o.order[k];
+    o.ids[k] = ids[i];
+    const body::State& x = states[i];
+    for (int d = 0; d < 3; ++d) {
+      o.r[3 * k + d] = x.q[d];
+      o.v[3 * k + d] = x.u[d];
+      o.w[3 * k + d] = x.u[3 + d];
+    }
+    for (int d = 0; d < 4; ++d) o.p[4 * k + d] = x.q[3 + d];
+    o.radius[k] = system.bounding_radii()[i];
+  }
+
+  const std::uint64_t index = written_.records;
+  const std::string name = record_name(index);
+  const double t = simulation.stepper().time();
+  const std::uint64_t step = simulation.stepper().steps();
+  // A record of the same index may be left from a run killed while writing it.
+  if (H5Lexists(o.records.get(), name.c_str(), H5P_DEFAULT) > 0) {
+    check(H5Ldelete(o.records.get(), name.c_str(), H5P_DEFAULT), o.file,
+          "cannot replace record " + name);
+  }
+  Handle group =
+      check(H5Gcreate2(o.records.get(), name.c_str(), H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT),
+            H5Gclose, o.file, "cannot create record " + name);
+  const hid_t real = o.float32 ? H5T_IEEE_F32LE : H5T_IEEE_F64LE;
+  h5::write_array(group.get(), "id", H5T_STD_U64LE, H5T_NATIVE_UINT64, n, 0, o.ids.data(), o.file);
+  h5::write_array(group.get(), "I_r_S", real, H5T_NATIVE_DOUBLE, n, 3, o.r.data(), o.file);
+  h5::write_array(group.get(), "p", real, H5T_NATIVE_DOUBLE, n, 4, o.p.data(), o.file);
+  h5::write_array(group.get(), "I_v_S", real, H5T_NATIVE_DOUBLE, n, 3, o.v.data(), o.file);
+  h5::write_array(group.get(), "K_omega", real, H5T_NATIVE_DOUBLE, n, 3, o.w.data(), o.file);
+  h5::write_array(group.get(), "radius", real, H5T_NATIVE_DOUBLE, n, 0, o.radius.data(), o.file);
+  h5::write_attribute(group.get(), "time", t, o.file);
+  h5::write_attribute(group.get(), "step", step, o.file);
+  group.close();
+  const std::uint64_t bodies = n;
+  // The tables may hold rows of a record that a killed run did not count: overwrite them.
+  h5::resize(o.record_time.get(), index, o.file, "records/time");
+  h5::resize(o.record_step.get(), index, o.file, "records/step");
+  h5::resize(o.record_bodies.get(), index, o.file, "records/bodies");
+  h5::append(o.record_time.get(), H5T_NATIVE_DOUBLE, &t, 1, o.file, "records/time");
+  h5::append(o.record_step.get(), H5T_NATIVE_UINT64, &step, 1, o.file, "records/step");
+  h5::append(o.record_bodies.get(), H5T_NATIVE_UINT64, &bodies, 1, o.file, "records/bodies");
+  // Everything of the record on disk first, then the count that makes it part of the file.
+  check(H5Fflush(o.handle.get(), H5F_SCOPE_LOCAL), o.file, "cannot flush");
+  h5::write_attribute(o.records.get(), "count", index + 1, o.file);
+  check(H5Fflush(o.handle.get(), H5F_SCOPE_LOCAL), o.file, "cannot flush");
+  written_.records = index + 1;
+  o.times.push_back(t);
+  o.counts.push_back(bodies);
+  write_xdmf();
+}
+
+void OutputFile::close(scene::Simulation& simulation) {
+  std::lock_guard lock(hdf5::mutex());
+  hdf5::QuietErrors quiet;
+  Impl& o = *impl_;
+  write_bodies(simulation);
+  write_steps();
+  for (Handle* h :
+       {&o.record_bodies, &o.record_step, &o.record_time, &o.records, &o.steps, &o.bodies}) {
+    h->close();
+  }
+  if (!o.handle.close()) h5::fail(o.file, "cannot close the output file");
+}
+
+void OutputFile::write_xdmf() const {
+  const Impl& o = *impl_;
+  const std::string h5_name = o.path.filename().string();
+  const char* precision = o.float32 ? "4" : "8";
+  std::ostringstream x;
+  x.precision(17);
+  x << "<?xml version=\"1.0\" ?>\n"
+    << "<!DOCTYPE Xdmf SYSTEM \"Xdmf.dtd\" []>\n"
+    << "<Xdmf Version=\"2.0\">\n"
+    << " <Domain>\n"
+    << "  <Grid Name=\"bodies\" GridType=\"Collection\" CollectionType=\"Temporal\">\n";
+  for (std::size_t k = 0; k < o.times.size(); ++k) {
+    const std::uint64_t n = o.counts[k];
+    if (n == 0) continue;  // ParaView cannot show an empty grid
+    const std::string base = h5_name + ":/records/" + record_name(k) + "/";
+    auto item = [&](const std::string& dims, const char* type, const char* bytes,
+                    const std::string& dataset) {
+      x << "     <DataItem Dimensions=\"" << dims << "\" NumberType=\"" << type << "\" Precision=\""
+        << bytes << "\" Format=\"HDF\">" << base << dataset << "</DataItem>\n";
+    };
+    const std::string vector = std::to_string(n) + " 3";
+    const std::string scalar = std::to_string(n);
+    x << "   <Grid Name=\"record " << record_name(k) << "\" GridType=\"Uniform\">\n"
+      << "    <Time Value=\"" << o.times[k] << "\"/>\n"
+      << "    <Topology TopologyType=\"Polyvertex\" NumberOfElements=\"" << n
+      << "\" NodesPerElement=\"1\"/>\n"
+      << "    <Geometry GeometryType=\"XYZ\">\n";
+    item(vector, "Float", precision, "I_r_S");
+    x << "    </Geometry>\n"
+      << "    <Attribute Name=\"radius\" AttributeType=\"Scalar\" Center=\"Node\">\n";
+    item(scalar, "Float", precision, "radius");
+    x << "    </Attribute>\n"
+      << "    <Attribute Name=\"velocity\" AttributeType=\"Vector\" Center=\"Node\">\n";
+    item(vector, "Float", precision, "I_v_S");
+    x << "    </Attribute>\n"
+      << "    <Attribute Name=\"angular_velocity_K\" AttributeType=\"Vector\" Center=\"Node\">\n";
+    item(vector, "Float", precision, "K_omega");
+    x << "    </Attribute>\n"
+      << "    <Attribute Name=\"id\" AttributeType=\"Scalar\" Center=\"Node\">\n";
+    item(scalar, "UInt", "8", "id");
+    x << "    </Attribute>\n"
+      << "   </Grid>\n";
+  }
+  x << "  </Grid>\n"
+    << " </Domain>\n"
+    << "</Xdmf>\n";
+  write_file_atomically(xdmf_path(o.path), x.str());
+}
+
+OutputSummary read_summary(const std::filesystem::path& path) {
+  std::lock_guard lock(hdf5::mutex());
+  hdf5::QuietErrors quiet;
+  const std::string file = path.string();
+  Handle handle = open_output(path, H5F_ACC_RDONLY);
+  const hid_t root = handle.get();
+  OutputSummary s;
+  s.scene_file = h5::read_string(root, "scene_file", file);
+  s.grbd_version = h5::read_string(root, "grbd_version", file);
+  s.date = h5::read_string(root, "date", file);
+  s.host = h5::read_string(root, "host", file);
+  s.precision = h5::read_string(root, "precision", file);
+  Handle records = open_group(root, "records", file);
+  s.records = h5::read_uint(records.get(), "count", file);
+  {
+    Handle bodies = open_dataset(root, "bodies", file);
+    s.bodies = h5::rows(bodies.get(), file, "bodies");
+  }
+  std::vector<h5::StepRow> steps;
+  Handle step_type = h5::step_row_type();
+  s.steps = h5::read_array(root, "steps", step_type.get(), -1, 0, steps, file);
+  double iterations = 0.0;
+  for (const h5::StepRow& row : steps) {
+    s.max_contacts = std::max<std::uint64_t>(s.max_contacts, row.contacts);
+    s.max_iterations = std::max<std::uint64_t>(
+        s.max_iterations, static_cast<std::uint64_t>(std::max(row.iterations, 0)));
+    iterations += row.iterations;
+    s.non_converged += row.converged ? 0 : 1;
+    s.max_penetration = std::max(s.max_penetration, row.max_penetration);
+    s.seconds += row.seconds_total;
+  }
+  if (!steps.empty()) s.mean_iterations = iterations / static_cast<double>(steps.size());
+  if (s.records > 0) {
+    std::vector<double> times;
+    std::vector<std::uint64_t> counts;
+    const std::uint64_t n =
+        h5::read_array(records.get(), "time", H5T_NATIVE_DOUBLE, -1, 0, times, file);
+    h5::read_array(records.get(), "bodies", H5T_NATIVE_UINT64, static_cast<std::int64_t>(n), 0,
+                   counts, file);
+    if (n < s.records) h5::fail(file, "records/time holds fewer rows than records@count");
+    s.t_first = times.front();
+    s.t_last = times[s.records - 1];
+    s.bodies_last = counts[s.records - 1];
+  }
+  return s;
+}
+
+Record read_record(const std::filesystem::path& path, std::uint64_t index) {
+  std::lock_guard lock(hdf5::mutex());
+  hdf5::QuietErrors quiet;
+  const std::string file = path.string();
+  Handle handle = open_output(path, H5F_ACC_RDONLY);
+  Handle records = open_group(handle.get(), "records", file);
+  const std::uint64_t count = h5::read_uint(records.get(), "count", file);
+  if (index >= count) {
+    h5::fail(file, "record " + std::to_string(index) + " asked for, the file holds " +
+                       std::to_string(count));
+  }
+  const std::string name = record_name(index);
+  Handle group = open_group(records.get(), name.c_str(), file);
+  Record record;
+  record.t = h5::read_double(group.get(), "time", file);
+  record.step = h5::read_uint(group.get(), "step", file);
+  const std::uint64_t n =
+      h5::read_array(group.get(), "id", H5T_NATIVE_UINT64, -1, 0, record.id, file);
+  std::vector<double> r, p, v, w;
+  const auto rows = static_cast<std::int64_t>(n);
+  h5::read_array(group.get(), "I_r_S", H5T_NATIVE_DOUBLE, rows, 3, r, file);
+  h5::read_array(group.get(), "p", H5T_NATIVE_DOUBLE, rows, 4, p, file);
+  h5::read_array(group.get(), "I_v_S", H5T_NATIVE_DOUBLE, rows, 3, v, file);
+  h5::read_array(group.get(), "K_omega", H5T_NATIVE_DOUBLE, rows, 3, w, file);
+  h5::read_array(group.get(), "radius", H5T_NATIVE_DOUBLE, rows, 0, record.radius, file);
+  record.states.resize(n);
+  for (std::uint64_t k = 0; k < n; ++k) {
+    body::State& x = record.states[k];
+    for (int d = 0; d < 3; ++d) {
+      x.q[d] = r[3 * k + d];
+      x.u[d] = v[3 * k + d];
+      x.u[3 + d] = w[3 * k + d];
+    }
+    for (int d = 0; d < 4; ++d) x.q[3 + d] = p[4 * k + d];
+  }
+  return record;
+}
+
+}  // namespace grbd::io

@@ -1,0 +1,87 @@
+// A whole run of a scene (chapter 7).
+
+#include "grbd/io/run.hpp"
+
+#include <chrono>
+#include <memory>
+
+namespace grbd::io {
+
+namespace {
+
+double seconds_since(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+}  // namespace
+
+RunResult run(const scene::Scene& scene, const RunOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
+  RunResult result;
+  std::unique_ptr<scene::Simulation> simulation;
+  std::unique_ptr<OutputFile> output;
+  if (options.restart) {
+    const Checkpoint checkpoint = read_checkpoint(*options.restart);
+    simulation = std::make_unique<scene::Simulation>(scene, checkpoint.state);
+    std::error_code error;
+    if (std::filesystem::exists(options.output, error)) {
+      output = std::make_unique<OutputFile>(options.output, scene, checkpoint.output);
+    } else {
+      output = std::make_unique<OutputFile>(options.output, scene);
+    }
+  } else {
+    simulation = std::make_unique<scene::Simulation>(scene);
+    output = std::make_unique<OutputFile>(options.output, scene);
+    output->write_record(*simulation);
+  }
+  scene::Simulation& sim = *simulation;
+  const std::uint64_t every = scene.output.every;
+  const std::uint64_t checkpoint_every = scene.checkpoint.every;
+  std::uint64_t saved_at = ~std::uint64_t{0};
+  auto save = [&] {
+    if (saved_at == sim.stepper().steps()) return;
+    saved_at = sim.stepper().steps();
+    const auto t0 = std::chrono::steady_clock::now();
+    output->flush(sim);
+    Checkpoint checkpoint{sim.save(), output->position(), scene.text};
+    write_checkpoint(options.checkpoint, checkpoint);
+    ++result.checkpoints;
+    result.output_seconds += seconds_since(t0);
+  };
+  bool recorded = true;  // the current state is the last record
+  while (!sim.finished()) {
+    if (options.stop != nullptr && *options.stop != 0) {
+      result.interrupted = true;
+      break;
+    }
+    const auto t0 = std::chrono::steady_clock::now();
+    const timestep::StepReport report = sim.step();
+    result.step_seconds += seconds_since(t0);
+    ++result.steps;
+    output->add_step(report, sim.system().size());
+    recorded = false;
+    const std::uint64_t step = sim.stepper().steps();
+    if (every > 0 && step % every == 0) {
+      const auto t1 = std::chrono::steady_clock::now();
+      output->write_record(sim);
+      result.output_seconds += seconds_since(t1);
+      recorded = true;
+    }
+    if (checkpoint_every > 0 && step % checkpoint_every == 0) save();
+    if (options.on_step) options.on_step(sim, report);
+  }
+  // The checkpoint first: the extra last record (not on the regular grid) is not part of what a
+  // restart continues from, so that it gives the same records as an uninterrupted run.
+  save();
+  if (!recorded && !result.interrupted) {
+    const auto t1 = std::chrono::steady_clock::now();
+    output->write_record(sim);
+    result.output_seconds += seconds_since(t1);
+  }
+  output->close(sim);
+  result.records = output->position().records;
+  result.seconds = seconds_since(start);
+  return result;
+}
+
+}  // namespace grbd::io

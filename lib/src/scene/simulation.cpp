@@ -1,0 +1,535 @@
+// A scene made runnable (chapter 7): materials, static geometry, generators, stepper, outlet.
+
+#include "grbd/scene/simulation.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+#include <unordered_map>
+
+#include "grbd/body/mass_properties.hpp"
+#include "grbd/collision/world.hpp"
+#include "grbd/kinematics/rotation.hpp"
+
+namespace grbd::scene {
+
+namespace {
+
+using collision::ShapeKind;
+
+double bounding_radius(ShapeKind shape, double radius, const Vector3& half_extents,
+                       double half_length) {
+  switch (shape) {
+    case ShapeKind::sphere:
+      return radius;
+    case ShapeKind::box:
+      return half_extents.norm();
+    case ShapeKind::capsule:
+      return radius + half_length;
+    default:
+      return 0.0;
+  }
+}
+
+// A uniformly distributed unit quaternion (Shoemake 1992, "Uniform random rotations").
+Vector7 random_orientation(Random& random, const Vector3& position) {
+  const double u1 = random.uniform();
+  const double u2 = 2.0 * M_PI * random.uniform();
+  const double u3 = 2.0 * M_PI * random.uniform();
+  const double a = std::sqrt(1.0 - u1);
+  const double b = std::sqrt(u1);
+  Vector7 q;
+  q << position, a * std::sin(u2), a * std::cos(u2), b * std::sin(u3), b * std::cos(u3);
+  q.tail<4>().normalize();
+  return q;
+}
+
+// Spheres (bounding spheres) in a hash grid of cells of edge h ≥ r_i + r_j for any two of them,
+// so that an overlap is always with a sphere of a neighbouring cell.
+class OverlapGrid {
+ public:
+  explicit OverlapGrid(double h) : h_(h) {}
+  void insert(const Vector3& c, double r) {
+    const auto index = static_cast<std::uint32_t>(centres_.size());
+    centres_.push_back(c);
+    radii_.push_back(r);
+    cells_[key(cell(c))].push_back(index);
+  }
+  bool overlaps(const Vector3& c, double r) const {
+    const Eigen::Array3i k = cell(c);
+    for (int dz = -1; dz <= 1; ++dz) {
+      for (int dy = -1; dy <= 1; ++dy) {
+        for (int dx = -1; dx <= 1; ++dx) {
+          const auto it = cells_.find(key(k + Eigen::Array3i(dx, dy, dz)));
+          if (it == cells_.end()) continue;
+          for (const std::uint32_t j : it->second) {
+            const double reach = r + radii_[j];
+            if ((centres_[j] - c).squaredNorm() < reach * reach) return true;
+          }
+        }
+      }
+    }
+    return false;
+  }
+
+ private:
+  Eigen::Array3i cell(const Vector3& c) const { return (c.array() / h_).floor().cast<int>(); }
+  static std::uint64_t key(const Eigen::Array3i& k) {
+    const auto part = [](int v) {
+      return static_cast<std::uint64_t>(static_cast<std::uint32_t>(v)) & 0x1FFFFF;
+    };
+    return part(k.x()) | (part(k.y()) << 21) | (part(k.z()) << 42);
+  }
+  double h_;
+  std::vector<Vector3> centres_;
+  std::vector<double> radii_;
+  std::unordered_map<std::uint64_t, std::vector<std::uint32_t>> cells_;
+};
+
+[[noreturn]] void fail(const Scene& scene, std::size_t group, const std::string& message) {
+  throw SceneError(scene.file.string() + ": bodies[" + std::to_string(group) + "] (" +
+                   scene.groups[group].name + "): " + message);
+}
+
+constexpr std::uint64_t kMaxBodies = 100'000'000;
+
+}  // namespace
+
+double largest_bounding_radius(const BodyGroup& group) {
+  return bounding_radius(group.shape, group.radius.max(), group.half_extents, group.half_length);
+}
+
+collision::Shape shape_of(const BodyConstants& body) {
+  switch (body.shape) {
+    case ShapeKind::box:
+      return collision::Box{body.half_extents};
+    case ShapeKind::capsule:
+      return collision::Capsule{body.radius, body.half_length};
+    default:
+      return collision::Sphere{body.radius};
+  }
+}
+
+Simulation::Simulation(const Scene& scene) : Simulation(scene, nullptr) {}
+
+Simulation::Simulation(const Scene& scene, const SimulationState& state)
+    : Simulation(scene, &state) {}
+
+Simulation::Simulation(const Scene& scene, const SimulationState* state) : scene_(scene) {
+  for (const std::string& name : scene.materials) materials_.add(name);
+  if (scene.default_contact) materials_.set_default(*scene.default_contact);
+  for (const ContactSpec& c : scene.contacts) {
+    materials_.set_pair(*materials_.find(c.a), *materials_.find(c.b), c.law);
+  }
+  build_static();
+  check_shapes();
+  generators_.resize(scene.groups.size());
+  if (state == nullptr) {
+    for (std::size_t g = 0; g < scene.groups.size(); ++g) {
+      generators_[g].random = scene.groups[g].generator.seed;
+    }
+    generate_initial();
+  } else {
+    restore(*state);
+  }
+  try {
+    stepper_.emplace(system_, statics_, materials_, scene.settings);
+  } catch (const SceneError&) {
+    throw;
+  } catch (const InvalidArgument& e) {
+    throw SceneError(scene.file.string() + ": " + e.what());
+  }
+  if (state != nullptr) {
+    stepper_->set_clock(state->t, state->steps);
+    stepper_->warm_starts().store(state->warm_keys, state->warm_lambda);
+  }
+}
+
+void Simulation::build_static() {
+  for (std::size_t k = 0; k < scene_.statics.size(); ++k) {
+    const StaticSpec& s = scene_.statics[k];
+    timestep::StaticObject object;
+    object.id = k;
+    object.shape = s.shape;
+    object.pose = s.pose;
+    object.material = *materials_.find(s.material);
+    try {
+      statics_.add(std::move(object));
+    } catch (const InvalidArgument& e) {
+      throw SceneError(scene_.file.string() + ": static[" + std::to_string(k) + "] (" + s.name +
+                       "): " + e.what());
+    }
+  }
+}
+
+void Simulation::check_shapes() const {
+  const std::string supported =
+      "supported pairs: sphere with any shape, box or capsule with a half-space";
+  for (std::size_t g = 0; g < scene_.groups.size(); ++g) {
+    const ShapeKind a = scene_.groups[g].shape;
+    for (std::size_t h = g; h < scene_.groups.size(); ++h) {
+      const ShapeKind b = scene_.groups[h].shape;
+      if (!collision::supported(a, b)) {
+        fail(scene_, g,
+             "its " + std::string(collision::kind_name(a)) + "es can touch the " +
+                 std::string(collision::kind_name(b)) + "es of bodies[" + std::to_string(h) +
+                 "], a pair grbd cannot collide (" + supported + ")");
+      }
+    }
+    for (std::size_t s = 0; s < scene_.statics.size(); ++s) {
+      const ShapeKind b = collision::kind(scene_.statics[s].shape);
+      if (!collision::supported(a, b)) {
+        fail(scene_, g,
+             "its " + std::string(collision::kind_name(a)) + "es can touch static[" +
+                 std::to_string(s) + "] (" + scene_.statics[s].name + ", a " +
+                 std::string(collision::kind_name(b)) + "), a pair grbd cannot collide (" +
+                 supported + ")");
+      }
+    }
+  }
+}
+
+BodyConstants Simulation::make_constants(std::size_t group, Random& random) {
+  const BodyGroup& g = scene_.groups[group];
+  BodyConstants c;
+  c.id = next_id_;
+  c.shape = g.shape;
+  c.material = *materials_.find(g.material);
+  c.fixed = g.fixed;
+  body::MassProperties mass;
+  switch (g.shape) {
+    case ShapeKind::box:
+      c.half_extents = g.half_extents;
+      mass = body::box_mass_properties(g.half_extents, 1.0);
+      break;
+    case ShapeKind::capsule:
+      c.radius = g.radius.sample(random);
+      c.half_length = g.half_length;
+      mass = body::capsule_mass_properties(c.radius, 2.0 * g.half_length, 1.0);
+      break;
+    default:
+      c.radius = g.radius.sample(random);
+      mass = body::sphere_mass_properties(c.radius, 1.0);
+      break;
+  }
+  // Unit density first, then scaled: by the density, or to the given mass.
+  const double scale = g.density ? *g.density : *g.mass / mass.mass;
+  c.inertia.m = mass.mass * scale;
+  c.inertia.K_Theta = mass.M_Theta_S.diagonal() * scale;
+  return c;
+}
+
+void Simulation::add_body(const BodyConstants& constants, const body::State& state) {
+  timestep::BodySpec spec;
+  spec.id = constants.id;
+  spec.state = state;
+  spec.inertia = constants.inertia;
+  spec.shape = shape_of(constants);
+  spec.material = constants.material;
+  spec.dynamic = !constants.fixed;
+  system_.add(spec);
+  created_.push_back(constants);
+}
+
+BodyConstants Simulation::constants(std::size_t i) const {
+  BodyConstants c;
+  c.id = system_.ids()[i];
+  const collision::Shape& shape = system_.shapes()[i];
+  c.shape = collision::kind(shape);
+  if (const auto* s = std::get_if<collision::Sphere>(&shape)) c.radius = s->radius;
+  if (const auto* b = std::get_if<collision::Box>(&shape)) c.half_extents = b->half_extents;
+  if (const auto* k = std::get_if<collision::Capsule>(&shape)) {
+    c.radius = k->radius;
+    c.half_length = k->half_length;
+  }
+  c.inertia = system_.inertia()[i];
+  c.material = system_.materials()[i];
+  c.fixed = !system_.dynamic(i);
+  return c;
+}
+
+void Simulation::generate_initial() {
+  for (std::size_t g = 0; g < scene_.groups.size(); ++g) {
+    const BodyGroup& group = scene_.groups[g];
+    const GeneratorSpec& spec = group.generator;
+    if (spec.kind == GeneratorKind::inflow) continue;
+    Random random(generators_[g].random);
+    const double r_b = largest_bounding_radius(group);
+    auto state_at = [&](const Vector3& position) {
+      body::State x;
+      if (spec.random_orientation) {
+        x.q = random_orientation(random, position);
+      } else {
+        x.q << position, 1.0, 0.0, 0.0, 0.0;
+      }
+      x.u << group.I_v_S, group.K_omega;
+      return x;
+    };
+    std::uint64_t made = 0;
+    if (spec.kind == GeneratorKind::list) {
+      for (const Vector3& p : spec.positions) {
+        const BodyConstants c = make_constants(g, random);
+        add_body(c, state_at(p));
+        ++next_id_;
+        ++made;
+      }
+    } else if (spec.kind == GeneratorKind::lattice) {
+      const double s = spec.spacing > 0.0 ? spec.spacing : 2.0 * r_b;
+      if (s < 2.0 * r_b) {
+        std::ostringstream out;
+        out << "generator.spacing: expected at least twice the largest bounding radius ("
+            << 2.0 * r_b << " m) so that no bodies overlap, found " << s;
+        fail(scene_, g, out.str());
+      }
+      const Vector3 extent = spec.region.max - spec.region.min;
+      const Eigen::Array3d cells = (extent.array() / s).floor();
+      const double capacity = cells.prod();
+      if (capacity < 1.0 || (spec.count > 0 && static_cast<double>(spec.count) > capacity)) {
+        std::ostringstream out;
+        out << "generator.region: holds " << capacity << " lattice sites of spacing " << s
+            << " m, fewer than count = " << std::max<std::uint64_t>(spec.count, 1);
+        fail(scene_, g, out.str());
+      }
+      const double n = spec.count > 0 ? static_cast<double>(spec.count) : capacity;
+      if (n > static_cast<double>(kMaxBodies)) {
+        fail(scene_, g,
+             "generator: the lattice would hold " + std::to_string(n) +
+                 " bodies, more than 10⁸; give a count or a smaller region");
+      }
+      const auto nx = static_cast<std::uint64_t>(cells.x());
+      const auto ny = static_cast<std::uint64_t>(cells.y());
+      system_.reserve(system_.size() + static_cast<std::size_t>(n));
+      for (std::uint64_t k = 0; k < static_cast<std::uint64_t>(n); ++k) {
+        const Vector3 site(static_cast<double>(k % nx), static_cast<double>((k / nx) % ny),
+                           static_cast<double>(k / (nx * ny)));
+        BodyConstants c = make_constants(g, random);
+        const double r_i = bounding_radius(c.shape, c.radius, c.half_extents, c.half_length);
+        // A shift of at most s/2 − r_i per coordinate keeps neighbours apart and the body
+        // inside the region.
+        const double amplitude = spec.jitter * (0.5 * s - r_i);
+        Vector3 p = spec.region.min + (site.array() + 0.5).matrix() * s;
+        for (int d = 0; d < 3; ++d) p[d] += amplitude * (2.0 * random.uniform() - 1.0);
+        add_body(c, state_at(p));
+        ++next_id_;
+        ++made;
+      }
+    } else {  // packing: random sequential addition, largest bodies first
+      const Vector3 extent = spec.region.max - spec.region.min;
+      if (spec.count > kMaxBodies) {
+        fail(scene_, g,
+             "generator.count: expected at most 10⁸ bodies, found " + std::to_string(spec.count));
+      }
+      std::vector<BodyConstants> bodies;
+      bodies.reserve(spec.count);
+      double volume = 0.0;
+      for (std::uint64_t k = 0; k < spec.count; ++k) {
+        bodies.push_back(make_constants(g, random));
+        const double r = bounding_radius(bodies.back().shape, bodies.back().radius,
+                                         bodies.back().half_extents, bodies.back().half_length);
+        volume += 4.0 / 3.0 * M_PI * r * r * r;
+        ++next_id_;
+      }
+      const double fraction = volume / extent.prod();
+      if (fraction > 0.5) {
+        std::ostringstream out;
+        out << "generator: " << spec.count << " bounding spheres fill " << fraction
+            << " of the region; random sequential addition cannot exceed about 0.38: lower count "
+               "or enlarge the region";
+        fail(scene_, g, out.str());
+      }
+      // Ids follow the order of creation; placement goes largest first.
+      std::vector<std::size_t> order(bodies.size());
+      for (std::size_t k = 0; k < order.size(); ++k) order[k] = k;
+      std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+        return bodies[a].radius > bodies[b].radius;
+      });
+      double r_existing = 0.0;
+      for (double r : system_.bounding_radii()) r_existing = std::max(r_existing, r);
+      OverlapGrid grid(r_b + std::max(r_b, r_existing));
+      for (std::size_t i = 0; i < system_.size(); ++i) {
+        grid.insert(system_.states()[i].q.head<3>(), system_.bounding_radii()[i]);
+      }
+      std::vector<body::State> states(bodies.size());
+      for (std::size_t k : order) {
+        const BodyConstants& c = bodies[k];
+        const double r = bounding_radius(c.shape, c.radius, c.half_extents, c.half_length);
+        const Vector3 room = extent - Vector3::Constant(2.0 * r);
+        if ((room.array() < 0.0).any()) {
+          fail(scene_, g,
+               "generator.region: smaller than a body of bounding radius " + std::to_string(r) +
+                   " m");
+        }
+        bool placed = false;
+        for (int attempt = 0; attempt < spec.max_attempts && !placed; ++attempt) {
+          Vector3 p;
+          for (int d = 0; d < 3; ++d) p[d] = spec.region.min[d] + r + room[d] * random.uniform();
+          if (!grid.overlaps(p, r)) {
+            grid.insert(p, r);
+            states[k] = state_at(p);
+            placed = true;
+          }
+        }
+        if (!placed) {
+          std::ostringstream out;
+          out << "generator: could not place a body without overlap after max_attempts = "
+              << spec.max_attempts << " tries (" << made << " of " << spec.count
+              << " placed, volume fraction " << fraction << "): lower count or enlarge the region";
+          fail(scene_, g, out.str());
+        }
+        ++made;
+      }
+      system_.reserve(system_.size() + bodies.size());
+      for (std::size_t k = 0; k < bodies.size(); ++k) add_body(bodies[k], states[k]);
+    }
+    generators_[g].random = random.state();
+    generators_[g].created = made;
+  }
+}
+
+void Simulation::inflow() {
+  backlog_ = 0;
+  const double t = stepper_->time();
+  for (std::size_t g = 0; g < scene_.groups.size(); ++g) {
+    const BodyGroup& group = scene_.groups[g];
+    const GeneratorSpec& spec = group.generator;
+    if (spec.kind != GeneratorKind::inflow || t < spec.start) continue;
+    if (spec.stop > 0.0 && t > spec.stop) continue;
+    // Bodies due by the end of this step: rate × (t + Δt − start), at most count (10⁻⁶ of a
+    // body absorbs the round-off of t, a sum of steps).
+    auto due = static_cast<std::uint64_t>(
+        std::floor(spec.rate * (t + scene_.settings.dt - spec.start) + 1e-6));
+    if (spec.count > 0) due = std::min(due, spec.count);
+    GeneratorState& state = generators_[g];
+    if (due <= state.created) continue;
+    Random random(state.random);
+    const double r_b = largest_bounding_radius(group);
+    double r_existing = 0.0;
+    const Vector3 lo = spec.region.min;
+    const Vector3 hi = spec.region.max;
+    std::vector<std::size_t> near;
+    for (std::size_t i = 0; i < system_.size(); ++i) {
+      const double r = system_.bounding_radii()[i];
+      const Vector3 c = system_.states()[i].q.head<3>();
+      const double reach = r + r_b;
+      if ((c.array() >= lo.array() - reach).all() && (c.array() <= hi.array() + reach).all()) {
+        near.push_back(i);
+        r_existing = std::max(r_existing, r);
+      }
+    }
+    OverlapGrid grid(r_b + std::max(r_b, r_existing));
+    for (std::size_t i : near)
+      grid.insert(system_.states()[i].q.head<3>(), system_.bounding_radii()[i]);
+    while (state.created < due) {
+      // The body's radius and its tries are drawn from the saved state, so a body that does not
+      // fit now is drawn again, identically, at the next step.
+      Random trial = random;
+      BodyConstants c = make_constants(g, trial);
+      const double r = bounding_radius(c.shape, c.radius, c.half_extents, c.half_length);
+      const Vector3 room = (hi - lo) - Vector3::Constant(2.0 * r);
+      if ((room.array() < 0.0).any()) {
+        fail(
+            scene_, g,
+            "generator.region: smaller than a body of bounding radius " + std::to_string(r) + " m");
+      }
+      bool placed = false;
+      Vector3 p;
+      for (int attempt = 0; attempt < spec.max_attempts && !placed; ++attempt) {
+        for (int d = 0; d < 3; ++d) p[d] = lo[d] + r + room[d] * trial.uniform();
+        placed = !grid.overlaps(p, r);
+      }
+      if (!placed) {
+        backlog_ += due - state.created;
+        break;
+      }
+      body::State x;
+      if (spec.random_orientation) {
+        x.q = random_orientation(trial, p);
+      } else {
+        x.q << p, 1.0, 0.0, 0.0, 0.0;
+      }
+      x.u << group.I_v_S, group.K_omega;
+      grid.insert(p, r);
+      add_body(c, x);
+      ++next_id_;
+      ++state.created;
+      random = trial;
+    }
+    state.random = random.state();
+  }
+}
+
+void Simulation::outlet() {
+  if (!scene_.domain.enabled) return;
+  leaving_.clear();
+  const Region& box = scene_.domain.box;
+  const auto states = system_.states();
+  for (std::size_t i = 0; i < states.size(); ++i) {
+    const auto c = states[i].q.head<3>().array();
+    if ((c < box.min.array()).any() || (c > box.max.array()).any()) leaving_.push_back(i);
+  }
+  if (!leaving_.empty()) {
+    system_.remove(leaving_);
+    removed_ += leaving_.size();
+  }
+}
+
+timestep::StepReport Simulation::step() {
+  inflow();
+  timestep::StepReport report = stepper_->step();
+  outlet();
+  return report;
+}
+
+SimulationState Simulation::save() const {
+  SimulationState s;
+  s.t = stepper_->time();
+  s.steps = stepper_->steps();
+  s.next_id = next_id_;
+  s.removed = removed_;
+  s.bodies.reserve(system_.size());
+  for (std::size_t i = 0; i < system_.size(); ++i) s.bodies.push_back(constants(i));
+  s.states.assign(system_.states().begin(), system_.states().end());
+  const timestep::WarmStartTable& warm = stepper_->warm_starts();
+  s.warm_keys.assign(warm.keys().begin(), warm.keys().end());
+  s.warm_lambda.assign(warm.lambda().begin(), warm.lambda().end());
+  s.generators = generators_;
+  return s;
+}
+
+void Simulation::restore(const SimulationState& state) {
+  const std::string where = scene_.file.string() + ": restart: ";
+  if (state.generators.size() != scene_.groups.size()) {
+    throw SceneError(where + "expected a checkpoint of a scene with " +
+                     std::to_string(scene_.groups.size()) + " body groups, found " +
+                     std::to_string(state.generators.size()));
+  }
+  if (state.bodies.size() != state.states.size() ||
+      state.warm_keys.size() != state.warm_lambda.size()) {
+    throw SceneError(where + "the checkpoint's body or warm-start arrays differ in length");
+  }
+  generators_ = state.generators;
+  next_id_ = state.next_id;
+  removed_ = state.removed;
+  system_.reserve(state.bodies.size());
+  for (std::size_t i = 0; i < state.bodies.size(); ++i) {
+    if (state.bodies[i].material >= materials_.size()) {
+      throw SceneError(where + "body " + std::to_string(state.bodies[i].id) + " has material " +
+                       std::to_string(state.bodies[i].material) + ", the scene has " +
+                       std::to_string(materials_.size()));
+    }
+    timestep::BodySpec spec;
+    spec.id = state.bodies[i].id;
+    spec.state = state.states[i];
+    spec.inertia = state.bodies[i].inertia;
+    spec.shape = shape_of(state.bodies[i]);
+    spec.material = state.bodies[i].material;
+    spec.dynamic = !state.bodies[i].fixed;
+    try {
+      system_.add(spec);
+    } catch (const InvalidArgument& e) {
+      throw SceneError(where + e.what());
+    }
+  }
+}
+
+}  // namespace grbd::scene

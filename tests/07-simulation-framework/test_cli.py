@@ -1,0 +1,313 @@
+#!/usr/bin/env python3
+"""Chapter 7: the `grbd` command line, tested as a user runs it.
+
+Run by CTest as `test_cli.py <grbd executable> <test scene>` with Debian's python3 and h5py.
+Each test works in its own temporary folder. The reference for every restart test is the output
+of an uninterrupted run of the same scene: the records, the per-step table (all but the wall
+times), the body table and the materials must be bit-identical.
+"""
+
+import os
+import random
+import re
+import signal
+import subprocess
+import sys
+import tempfile
+import time
+import unittest
+import xml.etree.ElementTree as ET
+
+import h5py
+import numpy as np
+from numpy.lib.recfunctions import repack_fields
+
+GRBD = None
+SCENE = None
+
+
+def run(*args, **kwargs):
+    """Runs grbd with a time limit; returns the CompletedProcess."""
+    return subprocess.run([GRBD, *args], capture_output=True, text=True, timeout=600, **kwargs)
+
+
+def datasets(path):
+    """Every dataset of an HDF5 file as {path: numpy array}, wall-time columns left out."""
+    out = {}
+    with h5py.File(path, "r") as f:
+        count = int(f["records"].attrs["count"])
+
+        def visit(name, obj):
+            if not isinstance(obj, h5py.Dataset):
+                return
+            value = obj[()]
+            if value.dtype.names:
+                names = [n for n in value.dtype.names if not n.startswith("seconds")]
+                value = repack_fields(value[names])
+            if value.dtype.kind == "O":
+                value = np.array([v.decode() if isinstance(v, bytes) else v for v in value])
+            # Record groups beyond `count` are not part of the file (a killed run may leave one).
+            m = re.match(r"records/(\d+)/", name)
+            if m and int(m.group(1)) >= count:
+                return
+            if name in ("records/time", "records/step", "records/bodies"):
+                value = value[:count]
+            out[name] = value
+
+        f.visititems(visit)
+    return out
+
+
+class Scratch(unittest.TestCase):
+    """A test in its own temporary folder."""
+
+    def setUp(self):
+        self._folder = tempfile.TemporaryDirectory(prefix="grbd_cli_")
+        self.dir = self._folder.name
+
+    def tearDown(self):
+        self._folder.cleanup()
+
+    def path(self, name):
+        return os.path.join(self.dir, name)
+
+    def assertSameOutput(self, reference, other):
+        a = datasets(reference)
+        b = datasets(other)
+        self.assertEqual(sorted(a), sorted(b))
+        for name in a:
+            self.assertEqual(a[name].shape, b[name].shape, name)
+            self.assertTrue(a[name].tobytes() == b[name].tobytes(), f"{name} differs")
+        return len(a)
+
+    def reference(self, end_time=None):
+        """The output of an uninterrupted run."""
+        args = ["run", SCENE, "-q", "-o", self.path("ref.h5"), "-c", self.path("ref.ckpt.h5")]
+        if end_time is not None:
+            args += ["--end-time", str(end_time)]
+        result = run(*args)
+        self.assertEqual(result.returncode, 0, result.stderr)
+        return self.path("ref.h5")
+
+
+class Help(Scratch):
+    def test_every_subcommand_has_help_with_the_exit_codes(self):
+        for sub in ([], ["run"], ["validate"], ["info"]):
+            result = run(*sub, "--help")
+            self.assertEqual(result.returncode, 0, result.stderr)
+            self.assertIn("Exit codes", result.stdout)
+            self.assertIn("130", result.stdout)
+
+
+class BadCommandLines(Scratch):
+    def test_bad_options_exit_2_and_create_no_file(self):
+        out = self.path("out.h5")
+        with open(out, "w") as f:
+            f.write("an earlier file that must survive")
+        cases = [
+            ["run", SCENE, "-o", out, "--bogus"],
+            ["run", self.path("missing.toml"), "-o", out],
+            ["run", SCENE, "-o", out, "--end-time", "-1"],
+            ["run", SCENE, "-o", out, "--end-time", "soon"],
+            ["run", SCENE, "-o", out, "--progress", "sometimes"],
+            ["run", SCENE, "-o", out, "-c", out],
+            ["frobnicate"],
+            [],
+        ]
+        for args in cases:
+            result = run(*args)
+            self.assertEqual(result.returncode, 2, f"{args}: {result.stderr}")
+            self.assertTrue(result.stderr.strip(), f"{args}: no message")
+            with open(out) as f:
+                self.assertEqual(f.read(), "an earlier file that must survive", args)
+        self.assertEqual(sorted(os.listdir(self.dir)), ["out.h5"])
+
+    def test_a_bad_scene_exits_3_naming_file_line_and_key(self):
+        with open(SCENE) as f:
+            text = f.read()
+        bad = self.path("typo.toml")
+        with open(bad, "w") as f:
+            f.write(text.replace("jitter = 0.5", "jiter = 0.5"))
+        line = next(i for i, l in enumerate(text.splitlines(), 1) if l.startswith("jitter"))
+        result = run("run", bad, "-o", self.path("out.h5"))
+        self.assertEqual(result.returncode, 3)
+        self.assertIn(f"typo.toml:{line}:1: bodies[0].generator.jiter: unknown key", result.stderr)
+        self.assertIn('did you mean "jitter"', result.stderr)
+        self.assertFalse(os.path.exists(self.path("out.h5")))
+        result = run("validate", bad)
+        self.assertEqual(result.returncode, 3)
+
+    def test_info_refuses_a_file_that_is_not_an_output(self):
+        other = self.path("other.h5")
+        with h5py.File(other, "w") as f:
+            f["x"] = [1.0]
+        result = run("info", other)
+        self.assertEqual(result.returncode, 3)
+        self.assertIn("other.h5: is not a grbd output file", result.stderr)
+        text = self.path("text.h5")
+        with open(text, "w") as f:
+            f.write("not HDF5")
+        result = run("info", text)
+        self.assertEqual(result.returncode, 3)
+        self.assertIn("is not an HDF5 file", result.stderr)
+
+
+class Validate(Scratch):
+    def test_validate_summarises_without_running(self):
+        result = run("validate", SCENE)
+        self.assertEqual(result.returncode, 0, result.stderr)
+        self.assertIn("generated 100 bodies", result.stdout)
+        self.assertIn("created by the inflow", result.stdout)
+        self.assertTrue(result.stdout.rstrip().endswith("ok"))
+        self.assertEqual(os.listdir(self.dir), [])
+
+
+class Output(Scratch):
+    def test_a_run_writes_records_steps_bodies_and_attributes(self):
+        out = self.reference()
+        with h5py.File(out, "r") as f:
+            for key in ("format", "format_version", "grbd_version", "host", "date", "scene",
+                        "scene_file", "precision"):
+                self.assertIn(key, f.attrs)
+            with open(SCENE) as s:
+                self.assertEqual(f.attrs["scene"], s.read())
+            count = int(f["records"].attrs["count"])
+            self.assertEqual(count, 600 // 25 + 1)  # step 0, every 25 steps, the end
+            self.assertEqual(len(f["steps"]), 600)
+            self.assertEqual(list(f["steps"]["step"]), list(range(1, 601)))
+            self.assertEqual(len(f["bodies"]), len(set(f["bodies"]["id"])))
+            for k in range(count):
+                group = f["records/%06d" % k]
+                ids = group["id"][()]
+                self.assertTrue(np.all(np.diff(ids.astype(np.int64)) > 0), "ids ascending")
+                self.assertEqual(group["I_r_S"].shape, (len(ids), 3))
+                self.assertEqual(group["p"].shape, (len(ids), 4))
+                norms = np.linalg.norm(group["p"][()], axis=1)
+                self.assertLess(np.max(np.abs(norms - 1.0)), 1e-12)
+                self.assertEqual(group["I_r_S"].dtype, np.float64)
+                self.assertEqual(f["records/time"][k], group.attrs["time"])
+            last = f["records/%06d" % (count - 1)]
+            # Bodies left through the outlet and the inflow added some: both show in the ids.
+            self.assertLess(len(last["id"]), len(f["bodies"]))
+            self.assertGreater(len(f["bodies"]), 100)
+        result = run("info", out)
+        self.assertEqual(result.returncode, 0, result.stderr)
+        self.assertIn(f"records: {count}", result.stdout)
+
+    def test_float32_records_on_request(self):
+        with open(SCENE) as f:
+            text = f.read()
+        scene = self.path("float.toml")
+        with open(scene, "w") as f:
+            f.write(text.replace("every = 25\n", 'every = 25\nprecision = "float"\n'))
+        result = run("run", scene, "-q", "-o", self.path("f.h5"), "--end-time", "0.05")
+        self.assertEqual(result.returncode, 0, result.stderr)
+        with h5py.File(self.path("f.h5"), "r") as f:
+            self.assertEqual(f["records/000001/I_r_S"].dtype, np.float32)
+            self.assertEqual(f.attrs["precision"], "float")
+
+    def test_the_xdmf_names_only_datasets_that_exist_with_its_shapes(self):
+        out = self.reference()
+        xmf = out[:-3] + ".xmf"
+        tree = ET.parse(xmf)
+        grids = tree.findall(".//Grid[@GridType='Uniform']")
+        with h5py.File(out, "r") as f:
+            self.assertEqual(len(grids), int(f["records"].attrs["count"]))
+            items = 0
+            for grid in grids:
+                n = int(grid.find("Topology").get("NumberOfElements"))
+                for item in grid.iter("DataItem"):
+                    self.assertEqual(item.get("Format"), "HDF")
+                    file_name, dataset = item.text.strip().split(":", 1)
+                    self.assertEqual(file_name, os.path.basename(out))
+                    self.assertIn(dataset, f, dataset)
+                    dims = tuple(int(d) for d in item.get("Dimensions").split())
+                    self.assertEqual(f[dataset].shape, dims, dataset)
+                    self.assertEqual(dims[0], n)
+                    self.assertEqual(int(item.get("Precision")), f[dataset].dtype.itemsize)
+                    items += 1
+            self.assertEqual(items, 5 * len(grids))
+            times = [float(g.find("Time").get("Value")) for g in grids]
+            self.assertEqual(times, list(f["records/time"][()]))
+
+
+class Restart(Scratch):
+    def test_n_steps_restart_n_steps_is_bit_identical_to_2n(self):
+        reference = self.reference()
+        out, ckpt = self.path("b.h5"), self.path("b.ckpt.h5")
+        # 310 steps: neither a record nor a checkpoint step; the restart must drop the extra
+        # last record of the first run.
+        first = run("run", SCENE, "-q", "-o", out, "-c", ckpt, "--end-time", "0.155")
+        self.assertEqual(first.returncode, 0, first.stderr)
+        second = run("run", SCENE, "-q", "-o", out, "-c", ckpt, "--restart", ckpt)
+        self.assertEqual(second.returncode, 0, second.stderr)
+        n = self.assertSameOutput(reference, out)
+        self.assertGreater(n, 50)
+
+
+class Signals(Scratch):
+    END = "2.0"  # 4000 steps: a few seconds
+
+    def start(self, out, ckpt):
+        return subprocess.Popen([GRBD, "run", SCENE, "--progress", "lines", "-o", out, "-c", ckpt,
+                                 "--end-time", self.END],
+                                stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+
+    def wait_for(self, path, process):
+        deadline = time.time() + 120
+        while not os.path.exists(path):
+            self.assertIsNone(process.poll(), "the run ended before " + path)
+            self.assertLess(time.time(), deadline)
+            time.sleep(0.01)
+
+    def test_sigint_and_sigterm_checkpoint_close_and_resume_bit_identically(self):
+        reference = self.reference(self.END)
+        for sig, code in ((signal.SIGINT, 130), (signal.SIGTERM, 143)):
+            out, ckpt = self.path(f"s{code}.h5"), self.path(f"s{code}.ckpt.h5")
+            process = self.start(out, ckpt)
+            self.wait_for(ckpt, process)
+            time.sleep(0.3)
+            process.send_signal(sig)
+            stdout, stderr = process.communicate(timeout=120)
+            self.assertEqual(process.returncode, code, stderr)
+            self.assertIn("stopped", stdout)
+            with h5py.File(out, "r") as f:  # closed cleanly: it opens
+                stopped_at = int(f["steps"]["step"][-1])
+            self.assertLess(stopped_at, 4000)
+            result = run("run", SCENE, "-q", "-o", out, "-c", ckpt, "--restart", ckpt,
+                         "--end-time", self.END)
+            self.assertEqual(result.returncode, 0, result.stderr)
+            self.assertSameOutput(reference, out)
+
+    def test_kill_9_leaves_a_valid_checkpoint_and_a_readable_output(self):
+        reference = self.reference(self.END)
+        rng = random.Random(20261125)
+        for trial in range(3):
+            out, ckpt = self.path(f"k{trial}.h5"), self.path(f"k{trial}.ckpt.h5")
+            process = self.start(out, ckpt)
+            self.wait_for(ckpt, process)
+            time.sleep(rng.uniform(0.0, 1.0))
+            process.kill()
+            process.communicate(timeout=120)
+            self.assertEqual(process.returncode, -signal.SIGKILL)
+            # The output opens and every record it counts equals the uninterrupted run's.
+            with h5py.File(out, "r") as f, h5py.File(reference, "r") as g:
+                count = int(f["records"].attrs["count"])
+                self.assertGreaterEqual(count, 1)
+                for k in range(count):
+                    for name in ("id", "I_r_S", "p", "I_v_S", "K_omega"):
+                        a = f["records/%06d/%s" % (k, name)][()]
+                        b = g["records/%06d/%s" % (k, name)][()]
+                        self.assertTrue(np.array_equal(a, b), f"record {k} {name}")
+            # The checkpoint is valid: the run resumes from it and rewrites what follows it.
+            result = run("run", SCENE, "-q", "-o", out, "-c", ckpt, "--restart", ckpt,
+                         "--end-time", self.END)
+            self.assertEqual(result.returncode, 0, result.stderr)
+            self.assertSameOutput(reference, out)
+            self.assertFalse(os.path.exists(ckpt + ".tmp") and os.path.getsize(ckpt + ".tmp") == 0)
+
+
+if __name__ == "__main__":
+    GRBD = os.path.abspath(sys.argv[1])
+    SCENE = os.path.abspath(sys.argv[2])
+    unittest.main(argv=[sys.argv[0], "-v"] + sys.argv[3:])

@@ -1,0 +1,215 @@
+// Chapter 7: output records and checkpoints. A record gives back the states it was written from
+// (bit for bit in double precision, to float rounding in single); a checkpoint gives back every
+// part of the simulation state, so that 2N steps equal N steps, a restart and N steps, bit for
+// bit; checkpoints replace each other atomically; damaged files are refused with their name.
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include "grbd/io/checkpoint.hpp"
+#include "grbd/io/output.hpp"
+#include "grbd/io/run.hpp"
+#include "grbd/scene/scene.hpp"
+#include "grbd/scene/simulation.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+using grbd::io::IoError;
+using grbd::scene::Simulation;
+
+// A folder of its own for each test.
+class Folder : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ =
+        fs::temp_directory_path() /
+        ("grbd_io_" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+  fs::path path(const std::string& name) const { return dir_ / name; }
+  fs::path dir_;
+};
+
+grbd::scene::Scene chute() {
+  return grbd::scene::load_scene(fs::path(GRBD_CH07_DATA_DIR) / "chute.toml");
+}
+
+void expect_same_state(const grbd::scene::SimulationState& a,
+                       const grbd::scene::SimulationState& b) {
+  EXPECT_EQ(a.t, b.t);
+  EXPECT_EQ(a.steps, b.steps);
+  EXPECT_EQ(a.next_id, b.next_id);
+  EXPECT_EQ(a.removed, b.removed);
+  ASSERT_EQ(a.bodies.size(), b.bodies.size());
+  for (std::size_t i = 0; i < a.bodies.size(); ++i) {
+    EXPECT_EQ(a.bodies[i].id, b.bodies[i].id);
+    EXPECT_EQ(a.bodies[i].radius, b.bodies[i].radius);
+    EXPECT_EQ(a.bodies[i].inertia.m, b.bodies[i].inertia.m);
+    EXPECT_EQ(a.bodies[i].inertia.K_Theta, b.bodies[i].inertia.K_Theta);
+    EXPECT_EQ(a.bodies[i].material, b.bodies[i].material);
+    EXPECT_EQ(a.states[i].q, b.states[i].q) << "body " << i;
+    EXPECT_EQ(a.states[i].u, b.states[i].u) << "body " << i;
+  }
+  ASSERT_EQ(a.warm_keys.size(), b.warm_keys.size());
+  for (std::size_t k = 0; k < a.warm_keys.size(); ++k) {
+    EXPECT_TRUE(a.warm_keys[k] == b.warm_keys[k]);
+    EXPECT_EQ(a.warm_lambda[k], b.warm_lambda[k]);
+  }
+  ASSERT_EQ(a.generators.size(), b.generators.size());
+  for (std::size_t g = 0; g < a.generators.size(); ++g) {
+    EXPECT_EQ(a.generators[g].random, b.generators[g].random);
+    EXPECT_EQ(a.generators[g].created, b.generators[g].created);
+  }
+}
+
+TEST_F(Folder, ACheckpointRestoresEveryPartOfTheState) {
+  const auto scene = chute();
+  Simulation sim(scene);
+  for (int k = 0; k < 150; ++k) sim.step();
+  const auto state = sim.save();
+  ASSERT_GT(state.warm_keys.size(), 10U);
+  ASSERT_GT(state.generators[1].created, 0U);
+  grbd::io::write_checkpoint(path("c.h5"), {state, {3, 150, 200}, scene.text});
+  const grbd::io::Checkpoint back = grbd::io::read_checkpoint(path("c.h5"));
+  expect_same_state(state, back.state);
+  EXPECT_EQ(back.output.records, 3U);
+  EXPECT_EQ(back.output.steps, 150U);
+  EXPECT_EQ(back.output.bodies, 200U);
+  EXPECT_EQ(back.scene_text, scene.text);
+  // Rebuilt from it, the simulation saves the same state again.
+  Simulation restored(scene, back.state);
+  expect_same_state(state, restored.save());
+}
+
+TEST_F(Folder, TwoNStepsEqualNStepsARestartAndNSteps) {
+  const auto scene = chute();
+  Simulation straight(scene);
+  for (int k = 0; k < 600; ++k) straight.step();
+  Simulation first(scene);
+  for (int k = 0; k < 300; ++k) first.step();
+  grbd::io::write_checkpoint(path("c.h5"), {first.save(), {}, scene.text});
+  Simulation second(scene, grbd::io::read_checkpoint(path("c.h5")).state);
+  for (int k = 0; k < 300; ++k) second.step();
+  expect_same_state(straight.save(), second.save());
+  EXPECT_GT(straight.bodies_removed(), 0U);  // the outlet took part
+}
+
+TEST_F(Folder, RecordsGiveBackTheirStates) {
+  auto scene = chute();
+  for (const bool float32 : {false, true}) {
+    scene.output.float32 = float32;
+    const fs::path file = path(float32 ? "f.h5" : "d.h5");
+    Simulation sim(scene);
+    grbd::io::OutputFile out(file, scene);
+    for (int k = 0; k < 40; ++k) out.add_step(sim.step(), sim.system().size());
+    out.write_record(sim);
+    out.close(sim);
+    const grbd::io::Record record = grbd::io::read_record(file, 0);
+    EXPECT_EQ(record.step, 40U);
+    EXPECT_EQ(record.t, sim.stepper().time());
+    ASSERT_EQ(record.id.size(), sim.system().size());
+    for (std::size_t k = 0; k < record.id.size(); ++k) {
+      const std::size_t i = sim.system().index_of(record.id[k]);
+      const auto& x = sim.system().states()[i];
+      if (float32) {
+        for (int d = 0; d < 7; ++d)
+          EXPECT_EQ(record.states[k].q[d], static_cast<double>(static_cast<float>(x.q[d])));
+      } else {
+        EXPECT_EQ(record.states[k].q, x.q);
+        EXPECT_EQ(record.states[k].u, x.u);
+      }
+      if (k > 0) {
+        EXPECT_LT(record.id[k - 1], record.id[k]);
+      }
+    }
+    const grbd::io::OutputSummary s = grbd::io::read_summary(file);
+    EXPECT_EQ(s.records, 1U);
+    EXPECT_EQ(s.steps, 40U);
+    EXPECT_EQ(s.bodies, sim.bodies_created());
+    EXPECT_EQ(s.precision, float32 ? "float" : "double");
+  }
+}
+
+TEST_F(Folder, CheckpointsReplaceEachOtherAtomically) {
+  const auto scene = chute();
+  Simulation sim(scene);
+  grbd::io::write_checkpoint(path("c.h5"), {sim.save(), {}, scene.text});
+  for (int k = 0; k < 20; ++k) sim.step();
+  // A crash while writing the next one leaves its temporary file: the previous one is intact.
+  {
+    std::ofstream partial(path("c.h5.tmp"), std::ios::binary);
+    partial << "\x89HDF\r\n\x1a\n half a checkpoint";
+  }
+  EXPECT_EQ(grbd::io::read_checkpoint(path("c.h5")).state.steps, 0U);
+  // The next write replaces both.
+  grbd::io::write_checkpoint(path("c.h5"), {sim.save(), {}, scene.text});
+  EXPECT_EQ(grbd::io::read_checkpoint(path("c.h5")).state.steps, 20U);
+  EXPECT_FALSE(fs::exists(path("c.h5.tmp")));
+  // A folder that cannot be written: an IoError, and the old checkpoint is untouched.
+  EXPECT_THROW(
+      grbd::io::write_checkpoint(path("no/such/folder/c.h5"), {sim.save(), {}, scene.text}),
+      IoError);
+  EXPECT_EQ(grbd::io::read_checkpoint(path("c.h5")).state.steps, 20U);
+}
+
+TEST_F(Folder, DamagedCheckpointsAreRefusedWithTheirName) {
+  const auto scene = chute();
+  Simulation sim(scene);
+  for (int k = 0; k < 10; ++k) sim.step();
+  grbd::io::write_checkpoint(path("c.h5"), {sim.save(), {}, scene.text});
+  auto message = [](const fs::path& file) {
+    try {
+      grbd::io::read_checkpoint(file);
+    } catch (const IoError& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  EXPECT_EQ(message(path("missing.h5")), path("missing.h5").string() + ": no such checkpoint file");
+  {
+    std::ofstream text(path("text.h5"));
+    text << "not HDF5\n";
+  }
+  EXPECT_EQ(message(path("text.h5")), path("text.h5").string() + ": is not an HDF5 file");
+  // Cut short: every prefix of the file is refused with an IoError.
+  std::ifstream in(path("c.h5"), std::ios::binary);
+  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  for (const double fraction : {0.1, 0.5, 0.9, 0.99}) {
+    const auto n = static_cast<std::size_t>(fraction * static_cast<double>(bytes.size()));
+    std::ofstream cut(path("cut.h5"), std::ios::binary | std::ios::trunc);
+    cut.write(bytes.data(), static_cast<std::streamsize>(n));
+    cut.close();
+    const std::string m = message(path("cut.h5"));
+    EXPECT_EQ(m.rfind(path("cut.h5").string() + ": ", 0), 0U) << fraction << ": " << m;
+  }
+  // An output file is not a checkpoint.
+  grbd::io::OutputFile out(path("out.h5"), scene);
+  out.close(sim);
+  EXPECT_EQ(message(path("out.h5")),
+            path("out.h5").string() +
+                ": is not a grbd checkpoint (attribute format is not \"grbd checkpoint\")");
+}
+
+TEST_F(Folder, OutputCostsLittleOfARun) {
+  // The run's own measure of the time in records and checkpoints, at one record every 25 steps of
+  // a small scene (the 10⁵-sphere figure is measured by the benchmark, not asserted here).
+  const auto scene = chute();
+  grbd::io::RunOptions options;
+  options.output = path("o.h5");
+  options.checkpoint = path("o.ckpt.h5");
+  const grbd::io::RunResult result = grbd::io::run(scene, options);
+  EXPECT_EQ(result.steps, 600U);
+  EXPECT_EQ(result.records, 25U);
+  EXPECT_EQ(result.checkpoints, 6U);
+  EXPECT_FALSE(result.interrupted);
+  EXPECT_GT(result.step_seconds, 0.0);
+  EXPECT_LE(result.step_seconds + result.output_seconds, result.seconds);
+}
+
+}  // namespace
