@@ -1,0 +1,275 @@
+// Chapter 7 demo: Janssen's silo. Runs a scene file (a square silo of side D filled with beads
+// that settle) through grbd::io::run, the same driver as `grbd run`, with its HDF5 + XDMF output
+// in the data directory; after the last step it measures, from the contact percussions Λ of that
+// step (forces F = Λ/Δt), in horizontal slices of the fill:
+//   - the mean stress by Love's formula σ = (1/V) Σ_bodies Σ_contacts r ⊗ F, r the lever arm from
+//     the body's centre to the contact point, V the slice volume D² h;
+//   - the bulk density ρ_b (mass of the bodies whose centres lie in the slice over V);
+//   - the stress ratio K = σ_h/σ_v, σ_h = (σ_xx + σ_yy)/2, σ_v = σ_zz (compressive positive);
+//   - the mobilised wall friction μ_mob = Σ F_z / Σ F_N over the contacts with the side walls (the
+//     vertical friction force that carries weight, over the normal force);
+// fits Janssen's length λ in σ_v(d) = ρ_b g λ (1 − e^(−d/λ)) (d the depth below the free surface)
+// by least squares, and compares it with Janssen's λ = D/(4 μ K) for μ = μ_w and μ = μ_mob.
+// Checks the balance of the whole fill: the walls and the floor carry its weight.
+//
+// Usage: ch07_janssen <data directory> <scene.toml> [end_time]
+// Writes silo.h5, silo.xmf, silo.ckpt.h5 (the run), janssen.csv (per slice) and janssen.txt.
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <iomanip>
+#include <iostream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "grbd/io/run.hpp"
+#include "grbd/scene/scene.hpp"
+#include "grbd_demo/demo.hpp"
+
+namespace {
+
+constexpr const char* kProgram = "ch07_janssen";
+
+using grbd::Matrix3;
+using grbd::Vector3;
+
+// [janssen stress]
+// Love's mean stress of each slice [z_k, z_k + h) of a box of cross-section `area`, from the
+// contact forces of the last step: σ = (1/V) Σ over the bodies with centres in the slice of
+// Σ over their contacts of F ⊗ r (compressive stresses negative).
+std::vector<Matrix3> slice_stresses(const grbd::scene::Simulation& sim, double area, double h,
+                                    std::size_t slices) {
+  std::vector<Matrix3> sigma(slices, Matrix3::Zero());
+  const auto& problem = sim.stepper().problem();
+  const auto lambda = sim.stepper().percussions();
+  const double dt = sim.scene().settings.dt;
+  const auto states = sim.system().states();
+  auto add = [&](grbd::collision::BodyIndex body, const Vector3& r, const Vector3& F) {
+    if (body == grbd::collision::kStatic) return;
+    const double z = states[static_cast<std::size_t>(body)].q[2];
+    const auto k = static_cast<std::size_t>(std::max(0.0, std::floor(z / h)));
+    if (k < slices) sigma[k] += F * r.transpose() / (area * h);
+  };
+  for (std::size_t c = 0; c < problem.contacts.size(); ++c) {
+    const auto& contact = problem.contacts[c];
+    const Vector3 F =
+        (contact.n * lambda[c][0] + contact.t1 * lambda[c][1] + contact.t2() * lambda[c][2]) /
+        dt;  // on side a
+    add(contact.body_a, contact.r_a, F);
+    add(contact.body_b, contact.r_b, -F);
+  }
+  return sigma;
+}
+// [janssen stress]
+
+struct Analysis {
+  double D = 0.0, h = 0.0, rho_b = 0.0, z_surface = 0.0, K = 0.0, K_wall = 0.0, mu_w = 0.0,
+         mu_mob = 0.0;
+  double lambda_fit = 0.0, rms = 0.0, weight = 0.0, carried = 0.0;
+  std::vector<double> depth, sigma_v, sigma_h, sigma_wall, rho;
+  bool done = false;
+};
+
+// [janssen fit]
+// σ_v(d) = ρ_b g λ (1 − e^(−d/λ)): the λ of least squares, by golden-section search on log λ
+// (the sum of squares is unimodal in λ for data that rise and saturate).
+double fit_lambda(const std::vector<double>& d, const std::vector<double>& s, double rho_g) {
+  auto cost = [&](double log_lambda) {
+    const double l = std::exp(log_lambda);
+    double sum = 0.0;
+    for (std::size_t k = 0; k < d.size(); ++k) {
+      const double e = s[k] - rho_g * l * (1.0 - std::exp(-d[k] / l));
+      sum += e * e;
+    }
+    return sum;
+  };
+  double a = std::log(1e-4), b = std::log(1e2);
+  const double g = (std::sqrt(5.0) - 1.0) / 2.0;
+  for (int i = 0; i < 200; ++i) {
+    const double x1 = b - g * (b - a), x2 = a + g * (b - a);
+    if (cost(x1) < cost(x2))
+      b = x2;
+    else
+      a = x1;
+  }
+  return std::exp(0.5 * (a + b));
+}
+// [janssen fit]
+
+Analysis analyse(const grbd::scene::Simulation& sim) {
+  Analysis out;
+  const auto& scene = sim.scene();
+  // The silo: the side walls are the static half-spaces with horizontal normals.
+  double x_min = INFINITY, x_max = -INFINITY;
+  for (const auto& s : scene.statics) {
+    const auto* plane = std::get_if<grbd::collision::HalfSpace>(&s.shape);
+    if (plane != nullptr && std::abs(plane->I_n.x()) > 0.99) {
+      const double x = -plane->offset / plane->I_n.x();
+      x_min = std::min(x_min, x);
+      x_max = std::max(x_max, x);
+    }
+  }
+  out.D = x_max - x_min;
+  const double area = out.D * out.D;
+  double mean_diameter = 0.0, mass = 0.0, z_top = 0.0;
+  const auto states = sim.system().states();
+  for (std::size_t i = 0; i < sim.system().size(); ++i) {
+    mean_diameter += 2.0 * sim.system().bounding_radii()[i];
+    mass += sim.system().inertia()[i].m;
+    z_top = std::max(z_top, states[i].q[2]);
+  }
+  mean_diameter /= static_cast<double>(sim.system().size());
+  out.h = 2.0 * mean_diameter;
+  const auto slices = static_cast<std::size_t>(std::ceil(z_top / out.h)) + 1;
+  const std::vector<Matrix3> sigma = slice_stresses(sim, area, out.h, slices);
+  std::vector<double> slice_mass(slices, 0.0);
+  for (std::size_t i = 0; i < sim.system().size(); ++i) {
+    const auto k = static_cast<std::size_t>(std::max(0.0, std::floor(states[i].q[2] / out.h)));
+    if (k < slices) slice_mass[k] += sim.system().inertia()[i].m;
+  }
+  // The normal stress on the side walls per slice: Σ F_N over the wall contacts of the bodies in
+  // the slice, over the wall area 4 D h.
+  std::vector<double> wall(slices, 0.0);
+  {
+    const auto& problem = sim.stepper().problem();
+    const auto lambda = sim.stepper().percussions();
+    for (std::size_t c = 0; c < problem.contacts.size(); ++c) {
+      const auto& contact = problem.contacts[c];
+      if (contact.body_b != grbd::collision::kStatic || std::abs(contact.n.z()) > 0.5) continue;
+      const double z = states[static_cast<std::size_t>(contact.body_a)].q[2];
+      const auto k = static_cast<std::size_t>(std::max(0.0, std::floor(z / out.h)));
+      if (k < slices) wall[k] += lambda[c][0] / scene.settings.dt / (4.0 * out.D * out.h);
+    }
+  }
+  // Bulk density: the slices between the first (layered against the floor) and the last two.
+  const double g = -scene.settings.I_g.z();
+  std::size_t bulk = 0;
+  for (std::size_t k = 1; k + 3 < slices; ++k, ++bulk) out.rho_b += slice_mass[k] / (area * out.h);
+  out.rho_b /= static_cast<double>(bulk);
+  out.z_surface = mass / (out.rho_b * area);
+  double K_sum = 0.0, K_wall_sum = 0.0;
+  std::size_t K_count = 0;
+  std::vector<double> d_fit, s_fit;
+  for (std::size_t k = 0; k < slices; ++k) {
+    const double z = (static_cast<double>(k) + 0.5) * out.h;
+    const double sv = -sigma[k](2, 2);
+    const double sh = -0.5 * (sigma[k](0, 0) + sigma[k](1, 1));
+    out.depth.push_back(out.z_surface - z);
+    out.sigma_v.push_back(sv);
+    out.sigma_h.push_back(sh);
+    out.sigma_wall.push_back(wall[k]);
+    out.rho.push_back(slice_mass[k] / (area * out.h));
+    if (k >= 1 && k + 3 < slices) {  // the bulk, as for ρ_b
+      K_sum += sh / sv;
+      K_wall_sum += wall[k] / sv;
+      ++K_count;
+      d_fit.push_back(out.z_surface - z);
+      s_fit.push_back(sv);
+    }
+  }
+  out.K = K_sum / static_cast<double>(K_count);
+  out.K_wall = K_wall_sum / static_cast<double>(K_count);
+  out.lambda_fit = fit_lambda(d_fit, s_fit, out.rho_b * g);
+  double sq = 0.0, scale = 0.0;
+  for (std::size_t k = 0; k < d_fit.size(); ++k) {
+    const double model =
+        out.rho_b * g * out.lambda_fit * (1.0 - std::exp(-d_fit[k] / out.lambda_fit));
+    sq += (s_fit[k] - model) * (s_fit[k] - model);
+    scale = std::max(scale, s_fit[k]);
+  }
+  out.rms = std::sqrt(sq / static_cast<double>(d_fit.size())) / scale;
+  // Wall friction and the balance of the fill.
+  const auto& problem = sim.stepper().problem();
+  const auto lambda = sim.stepper().percussions();
+  const double dt = scene.settings.dt;
+  double normal = 0.0, tangential = 0.0;
+  for (std::size_t c = 0; c < problem.contacts.size(); ++c) {
+    const auto& contact = problem.contacts[c];
+    if (contact.body_b != grbd::collision::kStatic) continue;
+    const Vector3 F =
+        (contact.n * lambda[c][0] + contact.t1 * lambda[c][1] + contact.t2() * lambda[c][2]) / dt;
+    out.carried += F.z();
+    if (std::abs(contact.n.z()) < 0.5) {
+      normal += lambda[c][0] / dt;
+      tangential += F.z();  // the vertical friction, which carries weight
+    }
+  }
+  out.weight = mass * g;
+  out.mu_mob = tangential / normal;
+  for (const auto& c : scene.contacts) {
+    if (c.a != c.b) out.mu_w = c.law.mu;
+  }
+  out.done = true;
+  return out;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  if (grbd::demo::wants_help(argc, argv) || argc < 3 || argc > 4) {
+    (argc < 3 && !grbd::demo::wants_help(argc, argv) ? std::cerr : std::cout)
+        << "usage: " << kProgram << " <data directory> <scene.toml> [end_time]\n"
+        << "  runs Janssen's silo and fits the Janssen length; writes silo.h5, silo.xmf, "
+           "janssen.csv and janssen.txt\n";
+    return grbd::demo::wants_help(argc, argv) ? 0 : 2;
+  }
+  try {
+    const std::filesystem::path dir = argv[1];
+    if (const auto reason = grbd::demo::not_a_directory(dir)) {
+      std::cerr << kProgram << ": " << grbd::demo::directory_message("data directory", dir, *reason)
+                << '\n';
+      return 2;
+    }
+    grbd::scene::Scene scene = grbd::scene::load_scene(argv[2]);
+    if (argc == 4) scene.end_time = std::stod(argv[3]);
+    grbd::io::RunOptions options;
+    options.output = dir / "silo.h5";
+    options.checkpoint = dir / "silo.ckpt.h5";
+    Analysis a;
+    const std::uint64_t last = scene.steps();
+    options.on_step = [&](const grbd::scene::Simulation& sim,
+                          const grbd::timestep::StepReport& report) {
+      if (report.step == last) a = analyse(sim);
+    };
+    const grbd::io::RunResult result = grbd::io::run(scene, options);
+    if (!a.done) throw grbd::Error("the run stopped before its last step");
+
+    grbd::demo::OutputFile csv(dir / "janssen.csv");
+    csv << "# depth_m sigma_v_Pa sigma_h_Pa rho_kg_m3 janssen_fit_Pa hydrostatic_Pa "
+           "sigma_wall_Pa\n";
+    const double g = -scene.settings.I_g.z();
+    for (std::size_t k = 0; k < a.depth.size(); ++k) {
+      if (a.depth[k] < 0.0) continue;
+      const double fit = a.rho_b * g * a.lambda_fit * (1.0 - std::exp(-a.depth[k] / a.lambda_fit));
+      csv << a.depth[k] << ' ' << a.sigma_v[k] << ' ' << a.sigma_h[k] << ' ' << a.rho[k] << ' '
+          << fit << ' ' << a.rho_b * g * a.depth[k] << ' ' << a.sigma_wall[k] << '\n';
+    }
+    csv.finish();
+    const double lambda_w = a.D / (4.0 * a.mu_w * a.K);
+    const double lambda_mob = a.D / (4.0 * a.mu_mob * a.K);
+    const double lambda_wall = a.D / (4.0 * a.mu_mob * a.K_wall);
+    std::ostringstream text;
+    text << std::setprecision(4) << kProgram << ": D = " << a.D * 1e3 << " mm, " << result.steps
+         << " steps in " << result.seconds << " s (output " << std::setprecision(2)
+         << 100.0 * result.output_seconds / result.seconds << " %), " << std::setprecision(4)
+         << "fill height " << a.z_surface * 1e3 << " mm, rho_b = " << a.rho_b
+         << " kg/m^3; balance: walls and floor carry " << a.carried / a.weight
+         << " of the weight; K = " << a.K << ", mu_w = " << a.mu_w
+         << ", mobilised mu = " << a.mu_mob << "; fitted lambda = " << a.lambda_fit * 1e3
+         << " mm (rms " << a.rms * 100.0
+         << " % of max sigma_v); Janssen D/(4 mu_w K) = " << lambda_w * 1e3 << " mm (ratio "
+         << a.lambda_fit / lambda_w << "), D/(4 mu_mob K) = " << lambda_mob * 1e3 << " mm (ratio "
+         << a.lambda_fit / lambda_mob << "); at the walls K_w = sigma_wall/sigma_v = " << a.K_wall
+         << ", D/(4 mu_mob K_w) = " << lambda_wall * 1e3 << " mm (ratio "
+         << a.lambda_fit / lambda_wall << ")\n";
+    std::cout << text.str();
+    grbd::demo::OutputFile summary(dir / "janssen.txt");
+    summary << text.str();
+    summary.finish();
+    return 0;
+  } catch (...) {
+    return grbd::demo::report_exception(kProgram, "the chapter 7 framework");
+  }
+}
