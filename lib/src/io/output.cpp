@@ -406,26 +406,25 @@ void OutputFile::write_xdmf() const {
     };
     const std::string vector = std::to_string(n) + " 3";
     const std::string scalar = std::to_string(n);
+    auto attribute = [&](const char* name, const char* kind, const std::string& dims,
+                         const char* type, const char* bytes, const std::string& dataset) {
+      x << "    <Attribute Name=\"" << name << "\" AttributeType=\"" << kind
+        << "\" Center=\"Node\">\n";
+      item(dims, type, bytes, dataset);
+      x << "    </Attribute>\n";
+    };
     x << "   <Grid Name=\"record " << record_name(k) << "\" GridType=\"Uniform\">\n"
       << "    <Time Value=\"" << o.times[k] << "\"/>\n"
       << "    <Topology TopologyType=\"Polyvertex\" NumberOfElements=\"" << n
       << "\" NodesPerElement=\"1\"/>\n"
       << "    <Geometry GeometryType=\"XYZ\">\n";
     item(vector, "Float", precision, "I_r_S");
-    x << "    </Geometry>\n"
-      << "    <Attribute Name=\"radius\" AttributeType=\"Scalar\" Center=\"Node\">\n";
-    item(scalar, "Float", precision, "radius");
-    x << "    </Attribute>\n"
-      << "    <Attribute Name=\"velocity\" AttributeType=\"Vector\" Center=\"Node\">\n";
-    item(vector, "Float", precision, "I_v_S");
-    x << "    </Attribute>\n"
-      << "    <Attribute Name=\"angular_velocity_K\" AttributeType=\"Vector\" Center=\"Node\">\n";
-    item(vector, "Float", precision, "K_omega");
-    x << "    </Attribute>\n"
-      << "    <Attribute Name=\"id\" AttributeType=\"Scalar\" Center=\"Node\">\n";
-    item(scalar, "UInt", "8", "id");
-    x << "    </Attribute>\n"
-      << "   </Grid>\n";
+    x << "    </Geometry>\n";
+    attribute("radius", "Scalar", scalar, "Float", precision, "radius");
+    attribute("velocity", "Vector", vector, "Float", precision, "I_v_S");
+    attribute("angular_velocity_K", "Vector", vector, "Float", precision, "K_omega");
+    attribute("id", "Scalar", scalar, "UInt", "8", "id");
+    x << "   </Grid>\n";
   }
   x << "  </Grid>\n"
     << " </Domain>\n"

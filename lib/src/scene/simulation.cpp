@@ -86,6 +86,19 @@ class OverlapGrid {
   std::unordered_map<std::uint64_t, std::vector<std::uint32_t>> cells_;
 };
 
+// The state of a new body of `group` at `position`: the group's velocities, and a random
+// orientation when the generator asks for one (drawn from `random`), else the identity.
+body::State initial_state(const BodyGroup& group, Random& random, const Vector3& position) {
+  body::State x;
+  if (group.generator.random_orientation) {
+    x.q = random_orientation(random, position);
+  } else {
+    x.q << position, 1.0, 0.0, 0.0, 0.0;
+  }
+  x.u << group.I_v_S, group.K_omega;
+  return x;
+}
+
 [[noreturn]] void fail(const Scene& scene, std::size_t group, const std::string& message) {
   throw SceneError(scene.file.string() + ": bodies[" + std::to_string(group) + "] (" +
                    scene.groups[group].name + "): " + message);
@@ -255,16 +268,7 @@ void Simulation::generate_initial() {
     if (spec.kind == GeneratorKind::inflow) continue;
     Random random(generators_[g].random);
     const double r_b = largest_bounding_radius(group);
-    auto state_at = [&](const Vector3& position) {
-      body::State x;
-      if (spec.random_orientation) {
-        x.q = random_orientation(random, position);
-      } else {
-        x.q << position, 1.0, 0.0, 0.0, 0.0;
-      }
-      x.u << group.I_v_S, group.K_omega;
-      return x;
-    };
+    auto state_at = [&](const Vector3& position) { return initial_state(group, random, position); };
     std::uint64_t made = 0;
     if (spec.kind == GeneratorKind::list) {
       for (const Vector3& p : spec.positions) {
@@ -441,13 +445,7 @@ void Simulation::inflow() {
         backlog_ += due - state.created;
         break;
       }
-      body::State x;
-      if (spec.random_orientation) {
-        x.q = random_orientation(trial, p);
-      } else {
-        x.q << p, 1.0, 0.0, 0.0, 0.0;
-      }
-      x.u << group.I_v_S, group.K_omega;
+      const body::State x = initial_state(group, trial, p);
       grid.insert(p, r);
       add_body(c, x);
       ++next_id_;
