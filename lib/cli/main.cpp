@@ -147,11 +147,11 @@ int run_command(const std::string& scene_file, const std::optional<std::string>&
   }
   const bool bar = progress == "bar" || (progress == "auto" && isatty(STDERR_FILENO) != 0);
   Progress display(bar, scene.steps());
-  if (!quiet) {
-    options.on_step = [&](const grbd::scene::Simulation& sim, const grbd::timestep::StepReport& r) {
-      display.update(sim, r);
-    };
-  }
+  bool started = false;  // an error after the first step is a failed run, not bad input
+  options.on_step = [&](const grbd::scene::Simulation& sim, const grbd::timestep::StepReport& r) {
+    started = true;
+    if (!quiet) display.update(sim, r);
+  };
   install_handlers();
   options.stop = &g_signal;
   grbd::io::RunResult result;
@@ -160,11 +160,11 @@ int run_command(const std::string& scene_file, const std::optional<std::string>&
   } catch (const grbd::scene::SceneError& e) {
     display.finish();
     std::cerr << "grbd run: " << e.what() << '\n';
-    return kExitInput;
+    return started ? kExitFailed : kExitInput;
   } catch (const grbd::io::IoError& e) {
     display.finish();
     std::cerr << "grbd run: " << e.what() << '\n';
-    return kExitInput;
+    return started ? kExitFailed : kExitInput;
   } catch (const grbd::Error& e) {
     display.finish();
     std::cerr << "grbd run: the run failed: " << e.what() << '\n';

@@ -154,7 +154,7 @@ TEST(SceneFile, UnsupportedShapePairsAndUnreadableMeshesAreRefusedBeforeTheRun) 
   const std::string boxes =
       replace(kMinimal, "radius = 0.01", "shape = \"box\"\nhalf_extents = [0.01, 0.01, 0.01]");
   EXPECT_EQ(error_of(boxes, true),
-            "scene.toml: bodies[0] (bodies[0]): its boxes can touch the boxes of bodies[0], a "
+            "scene.toml: bodies[0] (bodies[0]): a box of it can touch a box of bodies[0], a "
             "pair grbd cannot collide (supported pairs: sphere with any shape, box or capsule "
             "with a half-space)");
   const std::string mesh = replace(kMinimal, "[[bodies]]",

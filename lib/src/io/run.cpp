@@ -27,7 +27,11 @@ RunResult run(const scene::Scene& scene, const RunOptions& options) {
     if (std::filesystem::exists(options.output, error)) {
       output = std::make_unique<OutputFile>(options.output, scene, checkpoint.output);
     } else {
+      // A new output: its body table starts with every body of the checkpoint.
       output = std::make_unique<OutputFile>(options.output, scene);
+      for (std::size_t i = 0; i < simulation->system().size(); ++i) {
+        simulation->created().push_back(simulation->constants(i));
+      }
     }
   } else {
     simulation = std::make_unique<scene::Simulation>(scene);
@@ -48,7 +52,9 @@ RunResult run(const scene::Scene& scene, const RunOptions& options) {
     ++result.checkpoints;
     result.output_seconds += seconds_since(t0);
   };
-  bool recorded = true;  // the current state is the last record
+  // Whether the current state is the last record: a fresh run has just written it; a restart has
+  // it when the checkpoint's step is on the record grid (an extra last record was dropped).
+  bool recorded = !options.restart || (every > 0 && sim.stepper().steps() % every == 0);
   while (!sim.finished()) {
     if (options.stop != nullptr && *options.stop != 0) {
       result.interrupted = true;

@@ -140,6 +140,7 @@ class TableReader {
   const toml::table& table() const { return table_; }
   const std::string& path() const { return path_; }
   std::string key_path(std::string_view key) const {
+    if (key.empty()) return path_;
     return path_.empty() ? std::string(key) : path_ + "." + std::string(key);
   }
 

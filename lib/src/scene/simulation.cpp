@@ -178,22 +178,30 @@ void Simulation::build_static() {
 void Simulation::check_shapes() const {
   const std::string supported =
       "supported pairs: sphere with any shape, box or capsule with a half-space";
+  // Whether bodies of group g can ever touch each other: two of them, one at least dynamic.
+  auto self_contact = [&](std::size_t g) {
+    const BodyGroup& group = scene_.groups[g];
+    return !group.fixed &&
+           (group.generator.kind != GeneratorKind::list || group.generator.positions.size() > 1);
+  };
   for (std::size_t g = 0; g < scene_.groups.size(); ++g) {
     const ShapeKind a = scene_.groups[g].shape;
     for (std::size_t h = g; h < scene_.groups.size(); ++h) {
       const ShapeKind b = scene_.groups[h].shape;
+      if (h == g && !self_contact(g)) continue;
+      if (scene_.groups[g].fixed && scene_.groups[h].fixed) continue;
       if (!collision::supported(a, b)) {
         fail(scene_, g,
-             "its " + std::string(collision::kind_name(a)) + "es can touch the " +
-                 std::string(collision::kind_name(b)) + "es of bodies[" + std::to_string(h) +
+             "a " + std::string(collision::kind_name(a)) + " of it can touch a " +
+                 std::string(collision::kind_name(b)) + " of bodies[" + std::to_string(h) +
                  "], a pair grbd cannot collide (" + supported + ")");
       }
     }
     for (std::size_t s = 0; s < scene_.statics.size(); ++s) {
       const ShapeKind b = collision::kind(scene_.statics[s].shape);
-      if (!collision::supported(a, b)) {
+      if (!scene_.groups[g].fixed && !collision::supported(a, b)) {
         fail(scene_, g,
-             "its " + std::string(collision::kind_name(a)) + "es can touch static[" +
+             "a " + std::string(collision::kind_name(a)) + " of it can touch static[" +
                  std::to_string(s) + "] (" + scene_.statics[s].name + ", a " +
                  std::string(collision::kind_name(b)) + "), a pair grbd cannot collide (" +
                  supported + ")");
@@ -396,12 +404,13 @@ void Simulation::inflow() {
   for (std::size_t g = 0; g < scene_.groups.size(); ++g) {
     const BodyGroup& group = scene_.groups[g];
     const GeneratorSpec& spec = group.generator;
-    if (spec.kind != GeneratorKind::inflow || t < spec.start) continue;
-    if (spec.stop > 0.0 && t > spec.stop) continue;
-    // Bodies due by the end of this step: rate × (t + Δt − start), at most count (10⁻⁶ of a
-    // body absorbs the round-off of t, a sum of steps).
-    auto due = static_cast<std::uint64_t>(
-        std::floor(spec.rate * (t + scene_.settings.dt - spec.start) + 1e-6));
+    if (spec.kind != GeneratorKind::inflow || t + scene_.settings.dt <= spec.start) continue;
+    // Bodies due by the end of this step (or by stop): rate × (t_end − start), at most count
+    // (10⁻⁶ of a body absorbs the round-off of t, a sum of steps). A backlog is still delivered
+    // after stop.
+    double t_end = t + scene_.settings.dt;
+    if (spec.stop > 0.0) t_end = std::min(t_end, spec.stop);
+    auto due = static_cast<std::uint64_t>(std::floor(spec.rate * (t_end - spec.start) + 1e-6));
     if (spec.count > 0) due = std::min(due, spec.count);
     GeneratorState& state = generators_[g];
     if (due <= state.created) continue;

@@ -5,7 +5,7 @@
 ///
 /// Layout (every name is in the chapter's table):
 /// - attributes of `/`: `format` ("grbd output"), `format_version`, `grbd_version`, `host`,
-///   `date` (UTC, ISO 8601), `scene_file`, `scene` (the scene's text), `precision`;
+///   `date` (UTC, ISO 8601), `scene_file`, `scene` (the scene's text), `precision`, `dt`;
 /// - `/materials`: the material names, a material's id is its index;
 /// - `/bodies`: one row per body created (id, shape, radius, half extents, half length, mass,
 ///   principal moments, material, fixed);

@@ -51,8 +51,8 @@ struct GeneratorSpec {
   GeneratorKind kind = GeneratorKind::list;  ///< which generator
   std::vector<Vector3> positions;            ///< list: the centres [m]
   Region region;                             ///< lattice, packing, inflow: where the centres go
-  /// lattice: at most this many (0: as many as fit); packing: exactly this many; inflow: in all
-  /// (0: no limit until `stop`)
+  /// lattice: exactly this many, the first sites in x, y, z order (0: every site of the region);
+  /// packing: exactly this many; inflow: in all (0: no limit until `stop`)
   std::uint64_t count = 0;
   double spacing = 0.0;  ///< lattice: distance of neighbours [m] (0: 2 × the largest radius)
   double jitter = 0.0;   ///< lattice: random shift, a fraction in [0, 1] of the free gap
@@ -61,7 +61,9 @@ struct GeneratorSpec {
   double stop = 0.0;     ///< inflow: last time [s] (0: the end of the run)
   bool random_orientation = false;  ///< uniformly random orientations (else the identity)
   std::uint64_t seed = 0;           ///< of this group's random numbers
-  int max_attempts = 1000;          ///< packing, inflow: tries per body before giving up
+  /// tries per body before giving up: packing (default 1000) refuses the scene, inflow (default
+  /// 20) owes the body to the next step
+  int max_attempts = 1000;
 };
 
 /// A group of bodies of one shape and material.
