@@ -36,6 +36,17 @@ using grbd::Matrix3;
 using grbd::Vector3;
 
 // [janssen stress]
+// The force of contact c on its side a over the last step: F = (n Λ_N + t1 Λ_T1 + t2 Λ_T2)/Δt.
+Vector3 contact_force(const grbd::contact::CompactContact& contact, const Vector3& Lambda,
+                      double dt) {
+  return (contact.n * Lambda[0] + contact.t1 * Lambda[1] + contact.t2() * Lambda[2]) / dt;
+}
+
+// The slice [k h, (k + 1) h) that the height z falls in (0 below the floor).
+std::size_t slice_of(double z, double h) {
+  return static_cast<std::size_t>(std::max(0.0, std::floor(z / h)));
+}
+
 // Love's mean stress of each slice [z_k, z_k + h) of a box of cross-section `area`, from the
 // contact forces of the last step: σ = (1/V) Σ over the bodies with centres in the slice of
 // Σ over their contacts of F ⊗ r (compressive stresses negative).
@@ -48,15 +59,12 @@ std::vector<Matrix3> slice_stresses(const grbd::scene::Simulation& sim, double a
   const auto states = sim.system().states();
   auto add = [&](grbd::collision::BodyIndex body, const Vector3& r, const Vector3& F) {
     if (body == grbd::collision::kStatic) return;
-    const double z = states[static_cast<std::size_t>(body)].q[2];
-    const auto k = static_cast<std::size_t>(std::max(0.0, std::floor(z / h)));
+    const std::size_t k = slice_of(states[static_cast<std::size_t>(body)].q[2], h);
     if (k < slices) sigma[k] += F * r.transpose() / (area * h);
   };
   for (std::size_t c = 0; c < problem.contacts.size(); ++c) {
     const auto& contact = problem.contacts[c];
-    const Vector3 F =
-        (contact.n * lambda[c][0] + contact.t1 * lambda[c][1] + contact.t2() * lambda[c][2]) /
-        dt;  // on side a
+    const Vector3 F = contact_force(contact, lambda[c], dt);  // on side a
     add(contact.body_a, contact.r_a, F);
     add(contact.body_b, contact.r_b, -F);
   }
@@ -126,23 +134,29 @@ Analysis analyse(const grbd::scene::Simulation& sim) {
   const std::vector<Matrix3> sigma = slice_stresses(sim, area, out.h, slices);
   std::vector<double> slice_mass(slices, 0.0);
   for (std::size_t i = 0; i < sim.system().size(); ++i) {
-    const auto k = static_cast<std::size_t>(std::max(0.0, std::floor(states[i].q[2] / out.h)));
+    const std::size_t k = slice_of(states[i].q[2], out.h);
     if (k < slices) slice_mass[k] += sim.system().inertia()[i].m;
   }
-  // The normal stress on the side walls per slice: Σ F_N over the wall contacts of the bodies in
-  // the slice, over the wall area 4 D h.
+  // One pass over the contacts with the static geometry (side b): the force they carry (the
+  // balance of the fill), and on the side walls the normal stress per slice (Σ F_N over the
+  // wall area 4 D h of the slice) and the mobilised friction Σ F_z / Σ F_N.
   std::vector<double> wall(slices, 0.0);
-  {
-    const auto& problem = sim.stepper().problem();
-    const auto lambda = sim.stepper().percussions();
-    for (std::size_t c = 0; c < problem.contacts.size(); ++c) {
-      const auto& contact = problem.contacts[c];
-      if (contact.body_b != grbd::collision::kStatic || std::abs(contact.n.z()) > 0.5) continue;
-      const double z = states[static_cast<std::size_t>(contact.body_a)].q[2];
-      const auto k = static_cast<std::size_t>(std::max(0.0, std::floor(z / out.h)));
-      if (k < slices) wall[k] += lambda[c][0] / scene.settings.dt / (4.0 * out.D * out.h);
-    }
+  const auto& problem = sim.stepper().problem();
+  const auto lambda = sim.stepper().percussions();
+  const double dt = scene.settings.dt;
+  double normal = 0.0, vertical_friction = 0.0;
+  for (std::size_t c = 0; c < problem.contacts.size(); ++c) {
+    const auto& contact = problem.contacts[c];
+    if (contact.body_b != grbd::collision::kStatic) continue;
+    const Vector3 F = contact_force(contact, lambda[c], dt);
+    out.carried += F.z();
+    if (std::abs(contact.n.z()) > 0.5) continue;  // the floor
+    normal += lambda[c][0] / dt;
+    vertical_friction += F.z();  // the friction that carries weight
+    const std::size_t k = slice_of(states[static_cast<std::size_t>(contact.body_a)].q[2], out.h);
+    if (k < slices) wall[k] += lambda[c][0] / dt / (4.0 * out.D * out.h);
   }
+  out.mu_mob = vertical_friction / normal;
   // Bulk density: the slices between the first (layered against the floor) and the last two.
   const double g = -scene.settings.I_g.z();
   std::size_t bulk = 0;
@@ -180,24 +194,7 @@ Analysis analyse(const grbd::scene::Simulation& sim) {
     scale = std::max(scale, s_fit[k]);
   }
   out.rms = std::sqrt(sq / static_cast<double>(d_fit.size())) / scale;
-  // Wall friction and the balance of the fill.
-  const auto& problem = sim.stepper().problem();
-  const auto lambda = sim.stepper().percussions();
-  const double dt = scene.settings.dt;
-  double normal = 0.0, tangential = 0.0;
-  for (std::size_t c = 0; c < problem.contacts.size(); ++c) {
-    const auto& contact = problem.contacts[c];
-    if (contact.body_b != grbd::collision::kStatic) continue;
-    const Vector3 F =
-        (contact.n * lambda[c][0] + contact.t1 * lambda[c][1] + contact.t2() * lambda[c][2]) / dt;
-    out.carried += F.z();
-    if (std::abs(contact.n.z()) < 0.5) {
-      normal += lambda[c][0] / dt;
-      tangential += F.z();  // the vertical friction, which carries weight
-    }
-  }
   out.weight = mass * g;
-  out.mu_mob = tangential / normal;
   for (const auto& c : scene.contacts) {
     if (c.a != c.b) out.mu_w = c.law.mu;
   }

@@ -53,20 +53,7 @@ void write_checkpoint(const std::filesystem::path& path, const Checkpoint& check
     std::vector<h5::BodyRow> rows(n);
     std::vector<double> states(13 * n);
     for (std::size_t i = 0; i < n; ++i) {
-      const scene::BodyConstants& c = s.bodies[i];
-      h5::BodyRow& row = rows[i];
-      row = h5::BodyRow{};
-      row.id = c.id;
-      row.shape = static_cast<std::uint8_t>(c.shape);
-      row.fixed = c.fixed ? 1 : 0;
-      row.material = c.material;
-      row.radius = c.radius;
-      row.half_length = c.half_length;
-      row.mass = c.inertia.m;
-      for (int d = 0; d < 3; ++d) {
-        row.half_extents[d] = c.half_extents[d];
-        row.K_Theta[d] = c.inertia.K_Theta[d];
-      }
+      rows[i] = h5::body_row(s.bodies[i]);
       for (int d = 0; d < 7; ++d) states[13 * i + d] = s.states[i].q[d];
       for (int d = 0; d < 6; ++d) states[13 * i + 7 + d] = s.states[i].u[d];
     }
@@ -151,23 +138,12 @@ Checkpoint read_checkpoint(const std::filesystem::path& path) {
   s.states.resize(n);
   for (std::uint64_t i = 0; i < n; ++i) {
     const h5::BodyRow& row = rows[i];
-    scene::BodyConstants& b = s.bodies[i];
     if (row.shape > static_cast<std::uint8_t>(collision::ShapeKind::capsule) || row.fixed > 1 ||
         row.id >= s.next_id) {
       h5::fail(file, "dataset bodies, row " + std::to_string(i) +
                          ": expected a shape 0–2, fixed 0 or 1 and an id below next_id");
     }
-    b.id = row.id;
-    b.shape = static_cast<collision::ShapeKind>(row.shape);
-    b.fixed = row.fixed != 0;
-    b.material = row.material;
-    b.radius = row.radius;
-    b.half_length = row.half_length;
-    b.inertia.m = row.mass;
-    for (int d = 0; d < 3; ++d) {
-      b.half_extents[d] = row.half_extents[d];
-      b.inertia.K_Theta[d] = row.K_Theta[d];
-    }
+    s.bodies[i] = h5::body_constants(row);
     for (int d = 0; d < 7; ++d) s.states[i].q[d] = states[13 * i + d];
     for (int d = 0; d < 6; ++d) s.states[i].u[d] = states[13 * i + 7 + d];
   }

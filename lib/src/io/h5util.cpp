@@ -7,6 +7,45 @@
 
 namespace grbd::io::h5 {
 
+Handle string_type(const std::string& file) {
+  Handle type = check(H5Tcopy(H5T_C_S1), H5Tclose, file, "cannot create a string type");
+  H5Tset_size(type.get(), H5T_VARIABLE);
+  H5Tset_cset(type.get(), H5T_CSET_UTF8);
+  return type;
+}
+
+BodyRow body_row(const scene::BodyConstants& body) {
+  BodyRow row{};
+  row.id = body.id;
+  row.shape = static_cast<std::uint8_t>(body.shape);
+  row.fixed = body.fixed ? 1 : 0;
+  row.material = body.material;
+  row.radius = body.radius;
+  row.half_length = body.half_length;
+  row.mass = body.inertia.m;
+  for (int d = 0; d < 3; ++d) {
+    row.half_extents[d] = body.half_extents[d];
+    row.K_Theta[d] = body.inertia.K_Theta[d];
+  }
+  return row;
+}
+
+scene::BodyConstants body_constants(const BodyRow& row) {
+  scene::BodyConstants body;
+  body.id = row.id;
+  body.shape = static_cast<collision::ShapeKind>(row.shape);
+  body.fixed = row.fixed != 0;
+  body.material = row.material;
+  body.radius = row.radius;
+  body.half_length = row.half_length;
+  body.inertia.m = row.mass;
+  for (int d = 0; d < 3; ++d) {
+    body.half_extents[d] = row.half_extents[d];
+    body.inertia.K_Theta[d] = row.K_Theta[d];
+  }
+  return body;
+}
+
 Handle body_row_type() {
   Handle type(H5Tcreate(H5T_COMPOUND, sizeof(BodyRow)), H5Tclose);
   const hsize_t three = 3;
@@ -72,6 +111,16 @@ Handle open_attribute(hid_t object, const char* name, const std::string& file) {
                std::string("cannot open attribute ") + name);
 }
 
+// Opens an attribute that must hold one value.
+Handle open_scalar_attribute(hid_t object, const char* name, const std::string& file) {
+  Handle attribute = open_attribute(object, name, file);
+  Handle space = check(H5Aget_space(attribute.get()), H5Sclose, file, "cannot read a dataspace");
+  if (H5Sget_simple_extent_npoints(space.get()) != 1) {
+    fail(file, std::string("attribute ") + name + " is not a scalar");
+  }
+  return attribute;
+}
+
 }  // namespace
 
 void write_attribute(hid_t object, const char* name, double value, const std::string& file) {
@@ -84,18 +133,13 @@ void write_attribute(hid_t object, const char* name, std::uint64_t value, const 
 
 void write_attribute(hid_t object, const char* name, const std::string& value,
                      const std::string& file) {
-  Handle type = check(H5Tcopy(H5T_C_S1), H5Tclose, file, "cannot create a string type");
-  H5Tset_size(type.get(), H5T_VARIABLE);
-  H5Tset_cset(type.get(), H5T_CSET_UTF8);
+  Handle type = string_type(file);
   const char* text = value.c_str();
   write_scalar_attribute(object, name, type.get(), type.get(), &text, file);
 }
 
 double read_double(hid_t object, const char* name, const std::string& file) {
-  Handle attribute = open_attribute(object, name, file);
-  Handle space = check(H5Aget_space(attribute.get()), H5Sclose, file, "cannot read a dataspace");
-  if (H5Sget_simple_extent_npoints(space.get()) != 1)
-    fail(file, std::string("attribute ") + name + " is not a scalar");
+  Handle attribute = open_scalar_attribute(object, name, file);
   double value = 0.0;
   check(H5Aread(attribute.get(), H5T_NATIVE_DOUBLE, &value), file,
         std::string("attribute ") + name + " is not a number");
@@ -103,13 +147,10 @@ double read_double(hid_t object, const char* name, const std::string& file) {
 }
 
 std::uint64_t read_uint(hid_t object, const char* name, const std::string& file) {
-  Handle attribute = open_attribute(object, name, file);
+  Handle attribute = open_scalar_attribute(object, name, file);
   Handle type = check(H5Aget_type(attribute.get()), H5Tclose, file, "cannot read a type");
   if (H5Tget_class(type.get()) != H5T_INTEGER)
     fail(file, std::string("attribute ") + name + " is not an integer");
-  Handle space = check(H5Aget_space(attribute.get()), H5Sclose, file, "cannot read a dataspace");
-  if (H5Sget_simple_extent_npoints(space.get()) != 1)
-    fail(file, std::string("attribute ") + name + " is not a scalar");
   std::uint64_t value = 0;
   check(H5Aread(attribute.get(), H5T_NATIVE_UINT64, &value), file,
         std::string("attribute ") + name + " is not an unsigned integer");
@@ -117,16 +158,13 @@ std::uint64_t read_uint(hid_t object, const char* name, const std::string& file)
 }
 
 std::string read_string(hid_t object, const char* name, const std::string& file) {
-  Handle attribute = open_attribute(object, name, file);
+  Handle attribute = open_scalar_attribute(object, name, file);
   Handle type = check(H5Aget_type(attribute.get()), H5Tclose, file, "cannot read a type");
-  Handle space = check(H5Aget_space(attribute.get()), H5Sclose, file, "cannot read a dataspace");
-  if (H5Tget_class(type.get()) != H5T_STRING || H5Tis_variable_str(type.get()) <= 0 ||
-      H5Sget_simple_extent_npoints(space.get()) != 1) {
+  if (H5Tget_class(type.get()) != H5T_STRING || H5Tis_variable_str(type.get()) <= 0) {
     fail(file, std::string("attribute ") + name + " is not a variable-length string");
   }
-  Handle memory = check(H5Tcopy(H5T_C_S1), H5Tclose, file, "cannot create a string type");
-  H5Tset_size(memory.get(), H5T_VARIABLE);
-  H5Tset_cset(memory.get(), H5Tget_cset(type.get()));
+  Handle memory = string_type(file);
+  H5Tset_cset(memory.get(), H5Tget_cset(type.get()));  // no conversion between character sets
   char* text = nullptr;
   check(H5Aread(attribute.get(), memory.get(), &text), file,
         std::string("cannot read attribute ") + name);

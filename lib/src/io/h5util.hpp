@@ -29,6 +29,9 @@ inline void check(herr_t status, const std::string& file, const std::string& wha
   if (status < 0) fail(file, what);
 }
 
+/// A variable-length UTF-8 string type (attributes and string datasets).
+Handle string_type(const std::string& file);
+
 /// One row of /bodies (output) and of a checkpoint's /bodies.
 struct BodyRow {
   std::uint64_t id;
@@ -41,6 +44,10 @@ struct BodyRow {
   double mass;
   double K_Theta[3];
 };
+
+/// The row of a body's constants, and the constants of a row (as written).
+BodyRow body_row(const scene::BodyConstants& body);
+scene::BodyConstants body_constants(const BodyRow& row);
 
 /// One row of /steps.
 struct StepRow {

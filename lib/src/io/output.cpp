@@ -127,111 +127,103 @@ std::filesystem::path OutputFile::xdmf_path(const std::filesystem::path& path) {
 }
 
 OutputFile::OutputFile(const std::filesystem::path& path, const scene::Scene& scene)
-    : impl_(new Impl) {
+{
   std::lock_guard lock(hdf5::mutex());
   hdf5::QuietErrors quiet;
+  impl_.reset(new Impl);  // its compound types are HDF5 objects: made under the lock
   Impl& o = *impl_;
   o.path = path;
   o.file = path.string();
   o.float32 = scene.output.float32;
-  try {
-    o.handle = check(H5Fcreate(o.file.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT), H5Fclose,
-                     o.file, "cannot create the output file");
-    const hid_t root = o.handle.get();
-    h5::write_attribute(root, "format", std::string("grbd output"), o.file);
-    h5::write_attribute(root, "format_version", kOutputFormatVersion, o.file);
-    h5::write_attribute(root, "grbd_version", std::string(GRBD_VERSION), o.file);
-    h5::write_attribute(root, "host", host_name(), o.file);
-    h5::write_attribute(root, "date", utc_now(), o.file);
-    h5::write_attribute(root, "scene_file", scene.file.string(), o.file);
-    h5::write_attribute(root, "scene", scene.text, o.file);
-    h5::write_attribute(root, "precision", std::string(o.float32 ? "float" : "double"), o.file);
-    h5::write_attribute(root, "dt", scene.settings.dt, o.file);
-    {
-      Handle type = check(H5Tcopy(H5T_C_S1), H5Tclose, o.file, "cannot create a string type");
-      H5Tset_size(type.get(), H5T_VARIABLE);
-      H5Tset_cset(type.get(), H5T_CSET_UTF8);
-      std::vector<const char*> names;
-      for (const std::string& m : scene.materials) names.push_back(m.c_str());
-      h5::write_array(root, "materials", type.get(), type.get(), names.size(), 0, names.data(),
-                      o.file);
-    }
-    o.bodies = h5::create_table(root, "bodies", h5::packed(o.body_type.get()).get(), 4096, o.file);
-    o.steps = h5::create_table(root, "steps", h5::packed(o.step_type.get()).get(), 1024, o.file);
-    o.records = check(H5Gcreate2(root, "records", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Gclose,
-                      o.file, "cannot create group records");
-    o.record_time = h5::create_table(o.records.get(), "time", H5T_IEEE_F64LE, 256, o.file);
-    o.record_step = h5::create_table(o.records.get(), "step", H5T_STD_U64LE, 256, o.file);
-    o.record_bodies = h5::create_table(o.records.get(), "bodies", H5T_STD_U64LE, 256, o.file);
-    h5::write_attribute(o.records.get(), "count", std::uint64_t{0}, o.file);
-    check(H5Fflush(root, H5F_SCOPE_LOCAL), o.file, "cannot flush");
-    write_xdmf();
-  } catch (...) {
-    delete impl_;
-    throw;
+  o.handle = check(H5Fcreate(o.file.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT), H5Fclose,
+                   o.file, "cannot create the output file");
+  const hid_t root = o.handle.get();
+  h5::write_attribute(root, "format", std::string("grbd output"), o.file);
+  h5::write_attribute(root, "format_version", kOutputFormatVersion, o.file);
+  h5::write_attribute(root, "grbd_version", std::string(GRBD_VERSION), o.file);
+  h5::write_attribute(root, "host", host_name(), o.file);
+  h5::write_attribute(root, "date", utc_now(), o.file);
+  h5::write_attribute(root, "scene_file", scene.file.string(), o.file);
+  h5::write_attribute(root, "scene", scene.text, o.file);
+  h5::write_attribute(root, "precision", std::string(o.float32 ? "float" : "double"), o.file);
+  h5::write_attribute(root, "dt", scene.settings.dt, o.file);
+  {
+    Handle type = h5::string_type(o.file);
+    std::vector<const char*> names;
+    for (const std::string& m : scene.materials) names.push_back(m.c_str());
+    h5::write_array(root, "materials", type.get(), type.get(), names.size(), 0, names.data(),
+                    o.file);
   }
+  o.bodies = h5::create_table(root, "bodies", h5::packed(o.body_type.get()).get(), 4096, o.file);
+  o.steps = h5::create_table(root, "steps", h5::packed(o.step_type.get()).get(), 1024, o.file);
+  o.records = check(H5Gcreate2(root, "records", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Gclose,
+                    o.file, "cannot create group records");
+  o.record_time = h5::create_table(o.records.get(), "time", H5T_IEEE_F64LE, 256, o.file);
+  o.record_step = h5::create_table(o.records.get(), "step", H5T_STD_U64LE, 256, o.file);
+  o.record_bodies = h5::create_table(o.records.get(), "bodies", H5T_STD_U64LE, 256, o.file);
+  h5::write_attribute(o.records.get(), "count", std::uint64_t{0}, o.file);
+  check(H5Fflush(root, H5F_SCOPE_LOCAL), o.file, "cannot flush");
+  write_xdmf();
 }
 
 OutputFile::OutputFile(const std::filesystem::path& path, const scene::Scene& scene,
                        const OutputPosition& at)
-    : impl_(new Impl) {
+{
   std::lock_guard lock(hdf5::mutex());
   hdf5::QuietErrors quiet;
+  impl_.reset(new Impl);  // its compound types are HDF5 objects: made under the lock
   Impl& o = *impl_;
   o.path = path;
   o.file = path.string();
-  try {
-    o.handle = open_output(path, H5F_ACC_RDWR);
-    const hid_t root = o.handle.get();
-    o.float32 = h5::read_string(root, "precision", o.file) == "float";
-    if (o.float32 != scene.output.float32) {
-      h5::fail(o.file, "was written in " + std::string(o.float32 ? "float" : "double") +
-                           " precision, the scene asks for the other");
-    }
-    o.bodies = open_dataset(root, "bodies", o.file);
-    o.steps = open_dataset(root, "steps", o.file);
-    o.records = open_group(root, "records", o.file);
-    o.record_time = open_dataset(o.records.get(), "time", o.file);
-    o.record_step = open_dataset(o.records.get(), "step", o.file);
-    o.record_bodies = open_dataset(o.records.get(), "bodies", o.file);
-    const std::uint64_t count = h5::read_uint(o.records.get(), "count", o.file);
-    if (count < at.records || h5::rows(o.steps.get(), o.file, "steps") < at.steps ||
-        h5::rows(o.bodies.get(), o.file, "bodies") < at.bodies ||
-        h5::rows(o.record_time.get(), o.file, "records/time") < at.records) {
-      h5::fail(o.file, "holds less than the checkpoint counts (" + std::to_string(at.records) +
-                           " records, " + std::to_string(at.steps) + " steps, " +
-                           std::to_string(at.bodies) + " bodies): it is not this run's output");
-    }
-    // Drop what follows the checkpoint: it is written again.
-    for (std::uint64_t k = at.records;; ++k) {
-      const std::string name = record_name(k);
-      if (H5Lexists(o.records.get(), name.c_str(), H5P_DEFAULT) <= 0) break;
-      check(H5Ldelete(o.records.get(), name.c_str(), H5P_DEFAULT), o.file,
-            "cannot delete record " + name);
-    }
-    h5::write_attribute(o.records.get(), "count", at.records, o.file);
-    h5::resize(o.record_time.get(), at.records, o.file, "records/time");
-    h5::resize(o.record_step.get(), at.records, o.file, "records/step");
-    h5::resize(o.record_bodies.get(), at.records, o.file, "records/bodies");
-    h5::resize(o.steps.get(), at.steps, o.file, "steps");
-    h5::resize(o.bodies.get(), at.bodies, o.file, "bodies");
-    h5::read_array(o.records.get(), "time", H5T_NATIVE_DOUBLE,
-                   static_cast<std::int64_t>(at.records), 0, o.times, o.file);
-    h5::read_array(o.records.get(), "bodies", H5T_NATIVE_UINT64,
-                   static_cast<std::int64_t>(at.records), 0, o.counts, o.file);
-    check(H5Fflush(root, H5F_SCOPE_LOCAL), o.file, "cannot flush");
-    written_ = at;
-    write_xdmf();
-  } catch (...) {
-    delete impl_;
-    throw;
+  o.handle = open_output(path, H5F_ACC_RDWR);
+  const hid_t root = o.handle.get();
+  o.float32 = h5::read_string(root, "precision", o.file) == "float";
+  if (o.float32 != scene.output.float32) {
+    h5::fail(o.file, "was written in " + std::string(o.float32 ? "float" : "double") +
+                         " precision, the scene asks for the other");
   }
+  o.bodies = open_dataset(root, "bodies", o.file);
+  o.steps = open_dataset(root, "steps", o.file);
+  o.records = open_group(root, "records", o.file);
+  o.record_time = open_dataset(o.records.get(), "time", o.file);
+  o.record_step = open_dataset(o.records.get(), "step", o.file);
+  o.record_bodies = open_dataset(o.records.get(), "bodies", o.file);
+  const std::uint64_t count = h5::read_uint(o.records.get(), "count", o.file);
+  if (count < at.records || h5::rows(o.steps.get(), o.file, "steps") < at.steps ||
+      h5::rows(o.bodies.get(), o.file, "bodies") < at.bodies ||
+      h5::rows(o.record_time.get(), o.file, "records/time") < at.records) {
+    h5::fail(o.file, "holds less than the checkpoint counts (" + std::to_string(at.records) +
+                         " records, " + std::to_string(at.steps) + " steps, " +
+                         std::to_string(at.bodies) + " bodies): it is not this run's output");
+  }
+  // Drop what follows the checkpoint: it is written again.
+  for (std::uint64_t k = at.records;; ++k) {
+    const std::string name = record_name(k);
+    if (H5Lexists(o.records.get(), name.c_str(), H5P_DEFAULT) <= 0) break;
+    check(H5Ldelete(o.records.get(), name.c_str(), H5P_DEFAULT), o.file,
+          "cannot delete record " + name);
+  }
+  h5::write_attribute(o.records.get(), "count", at.records, o.file);
+  h5::resize(o.record_time.get(), at.records, o.file, "records/time");
+  h5::resize(o.record_step.get(), at.records, o.file, "records/step");
+  h5::resize(o.record_bodies.get(), at.records, o.file, "records/bodies");
+  h5::resize(o.steps.get(), at.steps, o.file, "steps");
+  h5::resize(o.bodies.get(), at.bodies, o.file, "bodies");
+  h5::read_array(o.records.get(), "time", H5T_NATIVE_DOUBLE, static_cast<std::int64_t>(at.records),
+                 0, o.times, o.file);
+  h5::read_array(o.records.get(), "bodies", H5T_NATIVE_UINT64,
+                 static_cast<std::int64_t>(at.records), 0, o.counts, o.file);
+  check(H5Fflush(root, H5F_SCOPE_LOCAL), o.file, "cannot flush");
+  written_ = at;
+  write_xdmf();
 }
 
-OutputFile::~OutputFile() {
+OutputFile::~OutputFile() = default;
+
+void OutputFile::Release::operator()(Impl* impl) const {
   std::lock_guard lock(hdf5::mutex());
   hdf5::QuietErrors quiet;
-  delete impl_;
+  delete impl;
 }
 
 void OutputFile::add_step(const timestep::StepReport& report, std::size_t bodies) {
@@ -260,22 +252,9 @@ void OutputFile::write_bodies(scene::Simulation& simulation) {
   Impl& o = *impl_;
   std::vector<scene::BodyConstants>& created = simulation.created();
   if (created.empty()) return;
-  std::vector<h5::BodyRow> rows(created.size());
-  for (std::size_t k = 0; k < created.size(); ++k) {
-    const scene::BodyConstants& c = created[k];
-    h5::BodyRow& row = rows[k];
-    row.id = c.id;
-    row.shape = static_cast<std::uint8_t>(c.shape);
-    row.fixed = c.fixed ? 1 : 0;
-    row.material = c.material;
-    row.radius = c.radius;
-    for (int d = 0; d < 3; ++d) {
-      row.half_extents[d] = c.half_extents[d];
-      row.K_Theta[d] = c.inertia.K_Theta[d];
-    }
-    row.half_length = c.half_length;
-    row.mass = c.inertia.m;
-  }
+  std::vector<h5::BodyRow> rows;
+  rows.reserve(created.size());
+  for (const scene::BodyConstants& c : created) rows.push_back(h5::body_row(c));
   h5::append(o.bodies.get(), o.body_type.get(), rows.data(), rows.size(), o.file, "bodies");
   written_.bodies += rows.size();
   created.clear();

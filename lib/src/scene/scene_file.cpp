@@ -199,16 +199,7 @@ class TableReader {
     return *value;
   }
   double to_real(const toml::node& node, std::string_view key, const Range& range) const {
-    double x = 0.0;
-    if (const auto* v = node.as_floating_point()) {
-      x = v->get();
-    } else if (const auto* i = node.as_integer()) {
-      x = static_cast<double>(i->get());
-    } else {
-      fail(node, key, range.text());
-    }
-    if (!range.contains(x)) fail(node, key, range.text());
-    return x;
+    return to_real_element(node, key, range.text(), range);
   }
 
   std::int64_t integer(std::string_view key, std::int64_t fallback, std::int64_t lo,
@@ -286,12 +277,7 @@ class TableReader {
     if (a == nullptr || a->size() != 3) fail(node, key, expected);
     Vector3 v;
     for (int k = 0; k < 3; ++k) {
-      const toml::node& x = *a->get(static_cast<std::size_t>(k));
-      if (!x.is_number()) fail(x, key, expected);
-      const double value =
-          x.is_integer() ? static_cast<double>(*x.value<std::int64_t>()) : *x.value<double>();
-      if (!range.contains(value)) fail(x, key, expected);
-      v[k] = value;
+      v[k] = to_real_element(*a->get(static_cast<std::size_t>(k)), key, expected, range);
     }
     return v;
   }
@@ -308,6 +294,7 @@ class TableReader {
     for (const toml::node& x : *a) out.push_back(to_real_element(x, key, expected.str(), range));
     return out;
   }
+  // A number (an integer is taken as one) in `range`; else fails with `expected`.
   double to_real_element(const toml::node& x, std::string_view key, const std::string& expected,
                          const Range& range) const {
     if (!x.is_number()) fail(x, key, expected);

@@ -13,22 +13,36 @@
 
 namespace grbd::scene {
 
+collision::Shape shape_of(const BodyConstants& body) {
+  switch (body.shape) {
+    case collision::ShapeKind::box:
+      return collision::Box{body.half_extents};
+    case collision::ShapeKind::capsule:
+      return collision::Capsule{body.radius, body.half_length};
+    default:
+      return collision::Sphere{body.radius};
+  }
+}
+
 namespace {
 
 using collision::ShapeKind;
 
-double bounding_radius(ShapeKind shape, double radius, const Vector3& half_extents,
-                       double half_length) {
-  switch (shape) {
-    case ShapeKind::sphere:
-      return radius;
-    case ShapeKind::box:
-      return half_extents.norm();
-    case ShapeKind::capsule:
-      return radius + half_length;
-    default:
-      return 0.0;
-  }
+// The radius of the sphere about S that holds the body.
+double bounding_radius(const BodyConstants& body) {
+  return collision::bounding_radius(shape_of(body));
+}
+
+// The body a spec describes, in the state x.
+timestep::BodySpec spec_of(const BodyConstants& body, const body::State& x) {
+  timestep::BodySpec spec;
+  spec.id = body.id;
+  spec.state = x;
+  spec.inertia = body.inertia;
+  spec.shape = shape_of(body);
+  spec.material = body.material;
+  spec.dynamic = !body.fixed;
+  return spec;
 }
 
 // A uniformly distributed unit quaternion (Shoemake 1992, "Uniform random rotations").
@@ -109,18 +123,12 @@ constexpr std::uint64_t kMaxBodies = 100'000'000;
 }  // namespace
 
 double largest_bounding_radius(const BodyGroup& group) {
-  return bounding_radius(group.shape, group.radius.max(), group.half_extents, group.half_length);
-}
-
-collision::Shape shape_of(const BodyConstants& body) {
-  switch (body.shape) {
-    case ShapeKind::box:
-      return collision::Box{body.half_extents};
-    case ShapeKind::capsule:
-      return collision::Capsule{body.radius, body.half_length};
-    default:
-      return collision::Sphere{body.radius};
-  }
+  BodyConstants largest;
+  largest.shape = group.shape;
+  largest.radius = group.radius.max();
+  largest.half_extents = group.half_extents;
+  largest.half_length = group.half_length;
+  return bounding_radius(largest);
 }
 
 Simulation::Simulation(const Scene& scene) : Simulation(scene, nullptr) {}
@@ -241,14 +249,7 @@ BodyConstants Simulation::make_constants(std::size_t group, Random& random) {
 }
 
 void Simulation::add_body(const BodyConstants& constants, const body::State& state) {
-  timestep::BodySpec spec;
-  spec.id = constants.id;
-  spec.state = state;
-  spec.inertia = constants.inertia;
-  spec.shape = shape_of(constants);
-  spec.material = constants.material;
-  spec.dynamic = !constants.fixed;
-  system_.add(spec);
+  system_.add(spec_of(constants, state));
   created_.push_back(constants);
 }
 
@@ -315,7 +316,7 @@ void Simulation::generate_initial() {
         const Vector3 site(static_cast<double>(k % nx), static_cast<double>((k / nx) % ny),
                            static_cast<double>(k / (nx * ny)));
         BodyConstants c = make_constants(g, random);
-        const double r_i = bounding_radius(c.shape, c.radius, c.half_extents, c.half_length);
+        const double r_i = bounding_radius(c);
         // A shift of at most s/2 − r_i per coordinate keeps neighbours apart and the body
         // inside the region.
         const double amplitude = spec.jitter * (0.5 * s - r_i);
@@ -336,8 +337,7 @@ void Simulation::generate_initial() {
       double volume = 0.0;
       for (std::uint64_t k = 0; k < spec.count; ++k) {
         bodies.push_back(make_constants(g, random));
-        const double r = bounding_radius(bodies.back().shape, bodies.back().radius,
-                                         bodies.back().half_extents, bodies.back().half_length);
+        const double r = bounding_radius(bodies.back());
         volume += 4.0 / 3.0 * M_PI * r * r * r;
         ++next_id_;
       }
@@ -364,7 +364,7 @@ void Simulation::generate_initial() {
       std::vector<body::State> states(bodies.size());
       for (std::size_t k : order) {
         const BodyConstants& c = bodies[k];
-        const double r = bounding_radius(c.shape, c.radius, c.half_extents, c.half_length);
+        const double r = bounding_radius(c);
         const Vector3 room = extent - Vector3::Constant(2.0 * r);
         if ((room.array() < 0.0).any()) {
           fail(scene_, g,
@@ -437,7 +437,7 @@ void Simulation::inflow() {
       // fit now is drawn again, identically, at the next step.
       Random trial = random;
       BodyConstants c = make_constants(g, trial);
-      const double r = bounding_radius(c.shape, c.radius, c.half_extents, c.half_length);
+      const double r = bounding_radius(c);
       const Vector3 room = (hi - lo) - Vector3::Constant(2.0 * r);
       if ((room.array() < 0.0).any()) {
         fail(
@@ -524,15 +524,8 @@ void Simulation::restore(const SimulationState& state) {
                        std::to_string(state.bodies[i].material) + ", the scene has " +
                        std::to_string(materials_.size()));
     }
-    timestep::BodySpec spec;
-    spec.id = state.bodies[i].id;
-    spec.state = state.states[i];
-    spec.inertia = state.bodies[i].inertia;
-    spec.shape = shape_of(state.bodies[i]);
-    spec.material = state.bodies[i].material;
-    spec.dynamic = !state.bodies[i].fixed;
     try {
-      system_.add(spec);
+      system_.add(spec_of(state.bodies[i], state.states[i]));
     } catch (const InvalidArgument& e) {
       throw SceneError(where + e.what());
     }

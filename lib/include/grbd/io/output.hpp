@@ -20,6 +20,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -80,7 +81,11 @@ class OutputFile {
   void write_bodies(scene::Simulation& simulation);
   void write_steps();
   void write_xdmf() const;
-  Impl* impl_;
+  // Deletes the HDF5 handles of Impl under grbd's HDF5 lock.
+  struct Release {
+    void operator()(Impl* impl) const;
+  };
+  std::unique_ptr<Impl, Release> impl_;
   OutputPosition written_;
 };
 
