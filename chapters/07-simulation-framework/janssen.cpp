@@ -25,6 +25,7 @@
 #include <vector>
 
 #include "grbd/io/run.hpp"
+#include "grbd/scene/measure.hpp"
 #include "grbd/scene/scene.hpp"
 #include "grbd_demo/demo.hpp"
 
@@ -35,43 +36,6 @@ constexpr const char* kProgram = "ch07_janssen";
 using grbd::Matrix3;
 using grbd::Vector3;
 
-// [janssen stress]
-// The force of contact c on its side a over the last step: F = (n Λ_N + t1 Λ_T1 + t2 Λ_T2)/Δt.
-Vector3 contact_force(const grbd::contact::CompactContact& contact, const Vector3& Lambda,
-                      double dt) {
-  return (contact.n * Lambda[0] + contact.t1 * Lambda[1] + contact.t2() * Lambda[2]) / dt;
-}
-
-// The slice [k h, (k + 1) h) that the height z falls in (0 below the floor).
-std::size_t slice_of(double z, double h) {
-  return static_cast<std::size_t>(std::max(0.0, std::floor(z / h)));
-}
-
-// Love's mean stress of each slice [z_k, z_k + h) of a box of cross-section `area`, from the
-// contact forces of the last step: σ = (1/V) Σ over the bodies with centres in the slice of
-// Σ over their contacts of F ⊗ r (compressive stresses negative).
-std::vector<Matrix3> slice_stresses(const grbd::scene::Simulation& sim, double area, double h,
-                                    std::size_t slices) {
-  std::vector<Matrix3> sigma(slices, Matrix3::Zero());
-  const auto& problem = sim.stepper().problem();
-  const auto lambda = sim.stepper().percussions();
-  const double dt = sim.scene().settings.dt;
-  const auto states = sim.system().states();
-  auto add = [&](grbd::collision::BodyIndex body, const Vector3& r, const Vector3& F) {
-    if (body == grbd::collision::kStatic) return;
-    const std::size_t k = slice_of(states[static_cast<std::size_t>(body)].q[2], h);
-    if (k < slices) sigma[k] += F * r.transpose() / (area * h);
-  };
-  for (std::size_t c = 0; c < problem.contacts.size(); ++c) {
-    const auto& contact = problem.contacts[c];
-    const Vector3 F = contact_force(contact, lambda[c], dt);  // on side a
-    add(contact.body_a, contact.r_a, F);
-    add(contact.body_b, contact.r_b, -F);
-  }
-  return sigma;
-}
-// [janssen stress]
-
 struct Analysis {
   double D = 0.0, h = 0.0, rho_b = 0.0, z_surface = 0.0, K = 0.0, K_wall = 0.0, mu_w = 0.0,
          mu_mob = 0.0;
@@ -79,32 +43,6 @@ struct Analysis {
   std::vector<double> depth, sigma_v, sigma_h, sigma_wall, rho;
   bool done = false;
 };
-
-// [janssen fit]
-// σ_v(d) = ρ_b g λ (1 − e^(−d/λ)): the λ of least squares, by golden-section search on log λ
-// (the sum of squares is unimodal in λ for data that rise and saturate).
-double fit_lambda(const std::vector<double>& d, const std::vector<double>& s, double rho_g) {
-  auto cost = [&](double log_lambda) {
-    const double l = std::exp(log_lambda);
-    double sum = 0.0;
-    for (std::size_t k = 0; k < d.size(); ++k) {
-      const double e = s[k] - rho_g * l * (1.0 - std::exp(-d[k] / l));
-      sum += e * e;
-    }
-    return sum;
-  };
-  double a = std::log(1e-4), b = std::log(1e2);
-  const double g = (std::sqrt(5.0) - 1.0) / 2.0;
-  for (int i = 0; i < 200; ++i) {
-    const double x1 = b - g * (b - a), x2 = a + g * (b - a);
-    if (cost(x1) < cost(x2))
-      b = x2;
-    else
-      a = x1;
-  }
-  return std::exp(0.5 * (a + b));
-}
-// [janssen fit]
 
 Analysis analyse(const grbd::scene::Simulation& sim) {
   Analysis out;
@@ -130,13 +68,11 @@ Analysis analyse(const grbd::scene::Simulation& sim) {
   }
   mean_diameter /= static_cast<double>(sim.system().size());
   out.h = 2.0 * mean_diameter;
-  const auto slices = static_cast<std::size_t>(std::ceil(z_top / out.h)) + 1;
-  const std::vector<Matrix3> sigma = slice_stresses(sim, area, out.h, slices);
-  std::vector<double> slice_mass(slices, 0.0);
-  for (std::size_t i = 0; i < sim.system().size(); ++i) {
-    const std::size_t k = slice_of(states[i].q[2], out.h);
-    if (k < slices) slice_mass[k] += sim.system().inertia()[i].m;
-  }
+  const grbd::scene::Slices grid{0.0, out.h, static_cast<std::size_t>(std::ceil(z_top / out.h)) + 1,
+                                 area};
+  const std::size_t slices = grid.count;
+  const std::vector<Matrix3> sigma = grbd::scene::slice_stresses(sim, grid);
+  const std::vector<double> slice_mass = grbd::scene::slice_masses(sim, grid);
   // One pass over the contacts with the static geometry (side b): the force they carry (the
   // balance of the fill), and on the side walls the normal stress per slice (Σ F_N over the
   // wall area 4 D h of the slice) and the mobilised friction Σ F_z / Σ F_N.
@@ -148,12 +84,12 @@ Analysis analyse(const grbd::scene::Simulation& sim) {
   for (std::size_t c = 0; c < problem.contacts.size(); ++c) {
     const auto& contact = problem.contacts[c];
     if (contact.body_b != grbd::collision::kStatic) continue;
-    const Vector3 F = contact_force(contact, lambda[c], dt);
+    const Vector3 F = grbd::scene::contact_force(contact, lambda[c], dt);
     out.carried += F.z();
     if (std::abs(contact.n.z()) > 0.5) continue;  // the floor
     normal += lambda[c][0] / dt;
     vertical_friction += F.z();  // the friction that carries weight
-    const std::size_t k = slice_of(states[static_cast<std::size_t>(contact.body_a)].q[2], out.h);
+    const std::size_t k = grid.slice_of(states[static_cast<std::size_t>(contact.body_a)].q[2]);
     if (k < slices) wall[k] += lambda[c][0] / dt / (4.0 * out.D * out.h);
   }
   out.mu_mob = vertical_friction / normal;
@@ -185,7 +121,7 @@ Analysis analyse(const grbd::scene::Simulation& sim) {
   }
   out.K = K_sum / static_cast<double>(K_count);
   out.K_wall = K_wall_sum / static_cast<double>(K_count);
-  out.lambda_fit = fit_lambda(d_fit, s_fit, out.rho_b * g);
+  out.lambda_fit = grbd::scene::fit_janssen_length(d_fit, s_fit, out.rho_b * g);
   double sq = 0.0, scale = 0.0;
   for (std::size_t k = 0; k < d_fit.size(); ++k) {
     const double model =

@@ -217,6 +217,9 @@ region = { min = [0, 0, 0], max = [0.01, 0.01, 0.01] }
   EXPECT_EQ(sim.bodies_removed(), left);
   EXPECT_EQ(sim.system().size(), 125U - left);
   EXPECT_GT(left, 0U);
+  // Every body has the same mass (4/3) π r³ ρ: the outlet's mass is that times the count.
+  const double m = sim.system().inertia()[0].m;
+  EXPECT_NEAR(sim.mass_removed(), static_cast<double>(left) * m, 1e-12 * m * 125.0);
 }
 
 TEST(Generators, MassOrDensityGiveTheBodysInertia) {

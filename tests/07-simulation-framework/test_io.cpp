@@ -46,6 +46,7 @@ void expect_same_state(const grbd::scene::SimulationState& a,
   EXPECT_EQ(a.steps, b.steps);
   EXPECT_EQ(a.next_id, b.next_id);
   EXPECT_EQ(a.removed, b.removed);
+  EXPECT_EQ(a.removed_mass, b.removed_mass);
   ASSERT_EQ(a.bodies.size(), b.bodies.size());
   for (std::size_t i = 0; i < a.bodies.size(); ++i) {
     EXPECT_EQ(a.bodies[i].id, b.bodies[i].id);

@@ -36,7 +36,7 @@ CHAPTERS = ["ch01_kinematics", "ch02_rigid_bodies", "ch03_smooth_references", "c
             "ch08_parallel_chute_flow"]
 # Chapters that are written (not only an outline): they must quote code and show figures.
 WRITTEN = ["ch01_kinematics", "ch02_rigid_bodies", "ch03_smooth_references", "ch04_collision",
-           "ch05_contact_laws", "ch06_moreau_timestepping"]
+           "ch05_contact_laws", "ch06_moreau_timestepping", "ch07_simulation_framework"]
 RESOURCE = re.compile(r'<(?:script|img|link|object)\b[^>]*?\b(?:src|href|data)="([^"]+)"', re.I)
 # MathJax files the book's configuration loads (the rest is loaded on demand by these).
 MATHJAX_FILES = ["MathJax.js", "jax/input/TeX/config.js", "jax/input/TeX/jax.js",

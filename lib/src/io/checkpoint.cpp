@@ -45,6 +45,7 @@ void write_checkpoint(const std::filesystem::path& path, const Checkpoint& check
     h5::write_attribute(root, "steps", s.steps, file);
     h5::write_attribute(root, "next_id", s.next_id, file);
     h5::write_attribute(root, "removed", s.removed, file);
+    h5::write_attribute(root, "removed_mass", s.removed_mass, file);
     h5::write_attribute(root, "output_records", checkpoint.output.records, file);
     h5::write_attribute(root, "output_steps", checkpoint.output.steps, file);
     h5::write_attribute(root, "output_bodies", checkpoint.output.bodies, file);
@@ -125,6 +126,7 @@ Checkpoint read_checkpoint(const std::filesystem::path& path) {
   s.steps = h5::read_uint(root, "steps", file);
   s.next_id = h5::read_uint(root, "next_id", file);
   s.removed = h5::read_uint(root, "removed", file);
+  s.removed_mass = h5::read_double(root, "removed_mass", file);
   c.output.records = h5::read_uint(root, "output_records", file);
   c.output.steps = h5::read_uint(root, "output_steps", file);
   c.output.bodies = h5::read_uint(root, "output_bodies", file);

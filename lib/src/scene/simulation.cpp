@@ -475,6 +475,7 @@ void Simulation::outlet() {
     if ((c < box.min.array()).any() || (c > box.max.array()).any()) leaving_.push_back(i);
   }
   if (!leaving_.empty()) {
+    for (std::size_t i : leaving_) removed_mass_ += system_.inertia()[i].m;
     system_.remove(leaving_);
     removed_ += leaving_.size();
   }
@@ -493,6 +494,7 @@ SimulationState Simulation::save() const {
   s.steps = stepper_->steps();
   s.next_id = next_id_;
   s.removed = removed_;
+  s.removed_mass = removed_mass_;
   s.bodies.reserve(system_.size());
   for (std::size_t i = 0; i < system_.size(); ++i) s.bodies.push_back(constants(i));
   s.states.assign(system_.states().begin(), system_.states().end());
@@ -517,6 +519,7 @@ void Simulation::restore(const SimulationState& state) {
   generators_ = state.generators;
   next_id_ = state.next_id;
   removed_ = state.removed;
+  removed_mass_ = state.removed_mass;
   system_.reserve(state.bodies.size());
   for (std::size_t i = 0; i < state.bodies.size(); ++i) {
     if (state.bodies[i].material >= materials_.size()) {

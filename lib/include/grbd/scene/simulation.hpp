@@ -44,6 +44,7 @@ struct SimulationState {
   std::uint64_t steps = 0;                      ///< steps done
   std::uint64_t next_id = 0;                    ///< the global id of the next body created
   std::uint64_t removed = 0;                    ///< bodies removed by the outlet so far
+  double removed_mass = 0.0;                    ///< their mass [kg]
   std::vector<BodyConstants> bodies;            ///< in the system's order
   std::vector<body::State> states;              ///< their states
   std::vector<timestep::ContactKey> warm_keys;  ///< the stepper's warm starts
@@ -89,6 +90,8 @@ class Simulation {
   /// Bodies created so far (all groups) and removed by the outlet.
   std::uint64_t bodies_created() const { return next_id_; }
   std::uint64_t bodies_removed() const { return removed_; }  ///< by the outlet
+  /// The mass the outlet removed so far [kg]: its rate is a discharge's mass flow.
+  double mass_removed() const { return removed_mass_; }
   /// Bodies an inflow generator owed but could not place (the region was full) at the last step.
   std::uint64_t inflow_backlog() const { return backlog_; }
 
@@ -112,6 +115,7 @@ class Simulation {
   std::vector<GeneratorState> generators_;
   std::uint64_t next_id_ = 0;
   std::uint64_t removed_ = 0;
+  double removed_mass_ = 0.0;
   std::uint64_t backlog_ = 0;
   std::vector<std::size_t> leaving_;
 };

@@ -1,5 +1,6 @@
 /// \file
-/// \brief Radius distributions and the generators' random numbers.
+/// \brief Radius distributions and the generators' random numbers; chapter 7 exercises: sampling
+/// the truncated normal and the piecewise-constant distribution by inversion.
 
 #include "grbd/scene/radius.hpp"
 
@@ -227,8 +228,9 @@ double RadiusDistribution::quantile(double u) const {
     case Kind::uniform:
       return std::min(hi_, lo_ + u * (hi_ - lo_));
     case Kind::truncated_normal: {
-      // Φ(z) = Φ_lo + u (Φ_hi − Φ_lo), inverted with erfc⁻¹ (Boost.Math); in the upper tail
-      // Q(z) = Q_lo + u (Q_hi − Q_lo) instead.
+      // BEGIN EXERCISE 7.1: the truncated normal by inversion
+      // Hint: solve Φ(z) = Φ_lo + u (Φ_hi − Φ_lo) with Φ⁻¹(p) = −√2 erfc⁻¹(2p) (Boost.Math); in
+      // Hint: the upper tail phi_lo_ and phi_hi_ hold Q = 1 − Φ instead, and Q⁻¹(p) = √2 erfc⁻¹(2p).
       const bool tail = (lo_ - mean_) / sd_ > 0.0;
       const double target = phi_lo_ + u * (phi_hi_ - phi_lo_);
       if (!(target > 0.0)) return lo_;
@@ -236,9 +238,12 @@ double RadiusDistribution::quantile(double u) const {
       const double z = tail ? std::numbers::sqrt2 * boost::math::erfc_inv(2.0 * target)
                             : -std::numbers::sqrt2 * boost::math::erfc_inv(2.0 * target);
       return std::clamp(mean_ + sd_ * z, lo_, hi_);
+      // END EXERCISE 7.1
     }
     case Kind::piecewise_constant: {
-      // The last interval with mass whose cumulative probability is ≤ u.
+      // BEGIN EXERCISE 7.2: the piecewise-constant distribution by inversion
+      // Hint: find the interval k with cumulative_[k] ≤ u < cumulative_[k + 1] (skip intervals
+      // Hint: of probability 0), then go linearly from edges_[k] to edges_[k + 1] within it.
       std::size_t k = static_cast<std::size_t>(
           std::upper_bound(cumulative_.begin(), cumulative_.end() - 1, u) - cumulative_.begin());
       k = k == 0 ? 0 : k - 1;
@@ -246,6 +251,7 @@ double RadiusDistribution::quantile(double u) const {
       while (probability_[k] == 0.0) ++k;
       const double t = std::clamp((u - cumulative_[k]) / probability_[k], 0.0, 1.0);
       return std::min(edges_[k + 1], edges_[k] + t * (edges_[k + 1] - edges_[k]));
+      // END EXERCISE 7.2
     }
   }
   return lo_;

@@ -1,0 +1,82 @@
+#pragma once
+/// \file
+/// \brief Measurements of granular experiments (chapter 7): Love's mean stress in horizontal
+/// slices from the contact percussions, the Janssen length, a steady rate from a cumulative
+/// series (a silo's mass flow), and Beverloo's law fitted to flow rates.
+
+#include <cstddef>
+#include <span>
+#include <vector>
+
+#include "grbd/core/types.hpp"
+#include "grbd/scene/simulation.hpp"
+
+namespace grbd::scene {
+
+/// Horizontal slices [z0 + k h, z0 + (k + 1) h), k = 0 … count − 1, of a vertical column of
+/// cross-section `area` (a silo): slice k has the volume V = area h.
+struct Slices {
+  double z0 = 0.0;        ///< bottom of slice 0 [m]
+  double h = 0.0;         ///< thickness [m] > 0
+  std::size_t count = 0;  ///< number of slices
+  double area = 0.0;      ///< cross-section [m²] > 0
+  /// The slice the height z falls in, or count when it lies below z0 or above the last slice.
+  std::size_t slice_of(double z) const;
+};
+
+/// The force of a contact on its side a over the last step, from its percussion
+/// Λ = (Λ_N, Λ_T1, Λ_T2): F = (n Λ_N + t1 Λ_T1 + t2 Λ_T2)/Δt [N].
+Vector3 contact_force(const contact::CompactContact& contact, const Vector3& Lambda, double dt);
+
+/// Love's mean stress of each slice from the contact percussions of the last step:
+/// σ = (1/V) Σ over the bodies whose centres lie in the slice of Σ over their contacts of F ⊗ r,
+/// F the force on the body and r the lever arm from its centre to the contact point (both sides
+/// of a contact between two bodies count; a static side has no centre). Compressive stresses are
+/// negative; the tensor is symmetric in equilibrium. Throws InvalidArgument for h ≤ 0 or
+/// area ≤ 0.
+std::vector<Matrix3> slice_stresses(const Simulation& sim, const Slices& slices);
+
+/// The mass of the bodies whose centres lie in each slice [kg].
+std::vector<double> slice_masses(const Simulation& sim, const Slices& slices);
+
+/// Janssen's length: the λ that minimises Σ_k (σ_k − ρ_b g λ (1 − e^(−d_k/λ)))² over
+/// λ ∈ [10⁻⁴, 10²] m, for the vertical stresses σ_k [Pa] at depths d_k [m] below the free
+/// surface and the weight density ρ_b g [N/m³]. Throws InvalidArgument for series of different
+/// lengths, fewer than 2 points, or a weight density that is not > 0.
+double fit_janssen_length(std::span<const double> depth, std::span<const double> sigma_v,
+                          double weight_density);
+
+/// A steady rate with its uncertainty.
+struct Rate {
+  double rate = 0.0;       ///< the least-squares slope [unit of the series per second]
+  double error = 0.0;      ///< the standard error of the mean of the block slopes
+  std::size_t blocks = 0;  ///< number of blocks the error comes from
+};
+
+/// The steady rate of a cumulative series m(t) (the mass a silo discharged by time t): the
+/// least-squares slope of the points with t ≥ t_start, and as its uncertainty the standard error
+/// σ/√B of the slopes of B consecutive blocks of equal duration (batch means: the increments of a
+/// discharge are correlated from step to step, which the scatter about one line would hide).
+/// Throws InvalidArgument for series of different lengths, times that do not increase, B < 2, or
+/// fewer than 2 points per block after t_start.
+Rate steady_rate(std::span<const double> t, std::span<const double> m, double t_start,
+                 std::size_t blocks = 5);
+
+/// Beverloo's law fitted to flow rates.
+struct BeverlooFit {
+  double C = 0.0;    ///< the discharge coefficient
+  double k = 0.0;    ///< the empty annulus, in particle diameters
+  double rms = 0.0;  ///< root mean square of W_fit/W − 1 over the points
+};
+
+/// Beverloo, Leniger and van de Velde (1961): W = C ρ_b √g (D − k d)^(5/2). Fitted, as they did,
+/// on the straight line (W/(ρ_b √g))^(2/5) = C^(2/5) D − C^(2/5) k d by least squares in D; one
+/// bulk density per point. Throws InvalidArgument for series of different lengths, fewer than 2
+/// points, fewer than 2 distinct D, or a rate, density, g or d that is not > 0.
+BeverlooFit fit_beverloo(std::span<const double> D, std::span<const double> W,
+                         std::span<const double> rho_b, double g, double d);
+
+/// W = C ρ_b √g (D − k d)^(5/2), 0 when D ≤ k d [kg/s].
+double beverloo_rate(double C, double k, double rho_b, double g, double D, double d);
+
+}  // namespace grbd::scene

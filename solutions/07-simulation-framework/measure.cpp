@@ -1,0 +1,237 @@
+/// \file
+/// \brief Chapter 7 exercises: the stress of a granular column from the contact percussions, the
+/// steady rate of a discharge, and Beverloo's law fitted to flow rates; with the Janssen fit.
+
+#include "grbd/scene/measure.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include "grbd/core/checks.hpp"
+#include "grbd/core/error.hpp"
+
+namespace grbd::scene {
+
+namespace {
+
+void require_same_length(const char* where, std::size_t a, std::size_t b) {
+  if (a != b) {
+    throw InvalidArgument(std::string(where) + ": expected series of the same length, found " +
+                          std::to_string(a) + " and " + std::to_string(b));
+  }
+}
+
+// The least-squares slope of the points (x_k, y_k), k ∈ [first, last).
+double slope(std::span<const double> x, std::span<const double> y, std::size_t first,
+             std::size_t last) {
+  const auto n = static_cast<double>(last - first);
+  double mx = 0.0, my = 0.0;
+  for (std::size_t k = first; k < last; ++k) {
+    mx += x[k];
+    my += y[k];
+  }
+  mx /= n;
+  my /= n;
+  double sxy = 0.0, sxx = 0.0;
+  for (std::size_t k = first; k < last; ++k) {
+    sxy += (x[k] - mx) * (y[k] - my);
+    sxx += (x[k] - mx) * (x[k] - mx);
+  }
+  return sxy / sxx;
+}
+
+}  // namespace
+
+std::size_t Slices::slice_of(double z) const {
+  const double k = std::floor((z - z0) / h);
+  if (!(k >= 0.0) || k >= static_cast<double>(count)) return count;
+  return static_cast<std::size_t>(k);
+}
+
+Vector3 contact_force(const contact::CompactContact& contact, const Vector3& Lambda, double dt) {
+  return (contact.n * Lambda[0] + contact.t1 * Lambda[1] + contact.t2() * Lambda[2]) / dt;
+}
+
+// [slice stresses]
+std::vector<Matrix3> slice_stresses(const Simulation& sim, const Slices& slices) {
+  if (!(slices.h > 0.0) || !(slices.area > 0.0)) {
+    throw InvalidArgument("slice_stresses: expected h > 0 and area > 0, found h = " +
+                          format_number(slices.h) + ", area = " + format_number(slices.area));
+  }
+  std::vector<Matrix3> sigma(slices.count, Matrix3::Zero());
+  const auto& problem = sim.stepper().problem();
+  const auto Lambda = sim.stepper().percussions();
+  const double dt = sim.scene().settings.dt;
+  const auto states = sim.system().states();
+  const double V = slices.area * slices.h;
+  // BEGIN EXERCISE 7.3: the stress from the percussions
+  // Hint: each contact adds F ⊗ r_a / V to the slice of body a and (−F) ⊗ r_b / V to that of b;
+  // Hint: a static side (collision::kStatic) has no centre and adds nothing.
+  auto add = [&](collision::BodyIndex body, const Vector3& r, const Vector3& F) {
+    if (body == collision::kStatic) return;
+    const std::size_t k = slices.slice_of(states[static_cast<std::size_t>(body)].q[2]);
+    if (k < slices.count) sigma[k] += F * r.transpose() / V;
+  };
+  for (std::size_t c = 0; c < problem.contacts.size(); ++c) {
+    const auto& contact = problem.contacts[c];
+    const Vector3 F = contact_force(contact, Lambda[c], dt);  // on side a
+    add(contact.body_a, contact.r_a, F);
+    add(contact.body_b, contact.r_b, -F);
+  }
+  return sigma;
+  // END EXERCISE 7.3
+}
+// [slice stresses]
+
+std::vector<double> slice_masses(const Simulation& sim, const Slices& slices) {
+  std::vector<double> mass(slices.count, 0.0);
+  const auto states = sim.system().states();
+  for (std::size_t i = 0; i < states.size(); ++i) {
+    const std::size_t k = slices.slice_of(states[i].q[2]);
+    if (k < slices.count) mass[k] += sim.system().inertia()[i].m;
+  }
+  return mass;
+}
+
+// [janssen fit]
+double fit_janssen_length(std::span<const double> depth, std::span<const double> sigma_v,
+                          double weight_density) {
+  require_same_length("fit_janssen_length", depth.size(), sigma_v.size());
+  if (depth.size() < 2 || !(weight_density > 0.0)) {
+    throw InvalidArgument(
+        "fit_janssen_length: expected at least 2 points and a weight density > 0, found " +
+        std::to_string(depth.size()) + " points and " + format_number(weight_density) + " N/m³");
+  }
+  // The sum of squares is unimodal in λ for data that rise and saturate: golden-section search
+  // on log λ.
+  auto cost = [&](double log_lambda) {
+    const double l = std::exp(log_lambda);
+    double sum = 0.0;
+    for (std::size_t k = 0; k < depth.size(); ++k) {
+      const double e = sigma_v[k] - weight_density * l * (1.0 - std::exp(-depth[k] / l));
+      sum += e * e;
+    }
+    return sum;
+  };
+  double a = std::log(1e-4), b = std::log(1e2);
+  const double g = (std::sqrt(5.0) - 1.0) / 2.0;
+  for (int i = 0; i < 200; ++i) {
+    const double x1 = b - g * (b - a), x2 = a + g * (b - a);
+    if (cost(x1) < cost(x2))
+      b = x2;
+    else
+      a = x1;
+  }
+  return std::exp(0.5 * (a + b));
+}
+// [janssen fit]
+
+// [steady rate]
+Rate steady_rate(std::span<const double> t, std::span<const double> m, double t_start,
+                 std::size_t blocks) {
+  require_same_length("steady_rate", t.size(), m.size());
+  for (std::size_t k = 1; k < t.size(); ++k) {
+    if (!(t[k] > t[k - 1])) {
+      throw InvalidArgument("steady_rate: expected increasing times, found t[" +
+                            std::to_string(k - 1) + "] = " + format_number(t[k - 1]) + ", t[" +
+                            std::to_string(k) + "] = " + format_number(t[k]));
+    }
+  }
+  const auto first =
+      static_cast<std::size_t>(std::lower_bound(t.begin(), t.end(), t_start) - t.begin());
+  const std::size_t n = t.size() - first;
+  if (blocks < 2 || n < 2 * blocks) {
+    throw InvalidArgument(
+        "steady_rate: expected at least 2 blocks of at least 2 points after t = " +
+        format_number(t_start) + ", found " + std::to_string(n) + " points for " +
+        std::to_string(blocks) + " blocks");
+  }
+  Rate out;
+  out.blocks = blocks;
+  // BEGIN EXERCISE 7.4: the steady mass flow rate
+  // Hint: the rate is the least-squares slope over [first, end); cut [t_first, t_last] into B
+  // Hint: blocks of equal duration, take the slope of each and the standard error of their mean.
+  out.rate = slope(t, m, first, t.size());
+  const double t0 = t[first];
+  const double span = t.back() - t0;
+  std::vector<double> rates;
+  std::size_t begin = first;
+  for (std::size_t b = 1; b <= blocks; ++b) {
+    const double t_end = t0 + span * static_cast<double>(b) / static_cast<double>(blocks);
+    std::size_t end = begin;
+    while (end < t.size() && (t[end] < t_end || b == blocks)) ++end;
+    if (end - begin < 2) {
+      throw InvalidArgument("steady_rate: block " + std::to_string(b) +
+                            " holds fewer than 2 points");
+    }
+    rates.push_back(slope(t, m, begin, end));
+    begin = end;
+  }
+  double mean = 0.0;
+  for (double r : rates) mean += r;
+  mean /= static_cast<double>(blocks);
+  double var = 0.0;
+  for (double r : rates) var += (r - mean) * (r - mean);
+  var /= static_cast<double>(blocks - 1);
+  out.error = std::sqrt(var / static_cast<double>(blocks));
+  // END EXERCISE 7.4
+  return out;
+}
+// [steady rate]
+
+// [beverloo fit]
+BeverlooFit fit_beverloo(std::span<const double> D, std::span<const double> W,
+                         std::span<const double> rho_b, double g, double d) {
+  require_same_length("fit_beverloo", D.size(), W.size());
+  require_same_length("fit_beverloo", D.size(), rho_b.size());
+  if (D.size() < 2 || !(g > 0.0) || !(d > 0.0)) {
+    throw InvalidArgument("fit_beverloo: expected at least 2 points, g > 0 and d > 0, found " +
+                          std::to_string(D.size()) + " points, g = " + format_number(g) +
+                          ", d = " + format_number(d));
+  }
+  for (std::size_t i = 0; i < D.size(); ++i) {
+    if (!(W[i] > 0.0) || !(rho_b[i] > 0.0) || !std::isfinite(D[i])) {
+      throw InvalidArgument("fit_beverloo: expected W > 0, rho_b > 0 and a finite D, found W = " +
+                            format_number(W[i]) + ", rho_b = " + format_number(rho_b[i]) +
+                            ", D = " + format_number(D[i]) + " at point " + std::to_string(i));
+    }
+  }
+  if (std::all_of(D.begin(), D.end(), [&](double x) { return x == D[0]; })) {
+    throw InvalidArgument("fit_beverloo: expected at least 2 distinct orifice sizes, found all " +
+                          format_number(D[0]));
+  }
+  BeverlooFit fit;
+  // BEGIN EXERCISE 7.5: Beverloo's law fitted to flow rates
+  // Hint: y = (W/(ρ_b √g))^(2/5) is a straight line a D + b in D; then C = a^(5/2), k = −b/(a d).
+  std::vector<double> y(D.size());
+  for (std::size_t i = 0; i < D.size(); ++i) y[i] = std::pow(W[i] / (rho_b[i] * std::sqrt(g)), 0.4);
+  const double a = slope(D, y, 0, D.size());
+  double mD = 0.0, my = 0.0;
+  for (std::size_t i = 0; i < D.size(); ++i) {
+    mD += D[i];
+    my += y[i];
+  }
+  const double b = (my - a * mD) / static_cast<double>(D.size());
+  fit.C = std::pow(a, 2.5);
+  fit.k = -b / (a * d);
+  // END EXERCISE 7.5
+  if (!(fit.C > 0.0) || !std::isfinite(fit.C) || !std::isfinite(fit.k)) {
+    throw InvalidArgument("fit_beverloo: the flow rates do not grow with D; no C > 0 fits them");
+  }
+  double sq = 0.0;
+  for (std::size_t i = 0; i < D.size(); ++i) {
+    const double e = beverloo_rate(fit.C, fit.k, rho_b[i], g, D[i], d) / W[i] - 1.0;
+    sq += e * e;
+  }
+  fit.rms = std::sqrt(sq / static_cast<double>(D.size()));
+  return fit;
+}
+// [beverloo fit]
+
+double beverloo_rate(double C, double k, double rho_b, double g, double D, double d) {
+  const double open = D - k * d;
+  return open > 0.0 ? C * rho_b * std::sqrt(g) * std::pow(open, 2.5) : 0.0;
+}
+
+}  // namespace grbd::scene
