@@ -1,0 +1,93 @@
+// Chapter 7: the chapter's experiments at reduced size, from the scene files of its folder. The
+// silo of silo.toml with a third of its beads: the walls and the floor carry the weight of the
+// fill, the walls carry a part of it by friction, and never more than Coulomb's μ_w allows. The
+// discharge of beverloo.toml over 0.3 s: the steady mass flow rate is Beverloo's
+// (Beverloo, Leniger and van de Velde 1961, C = 0.58, k = 1.5) within 20 %.
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "grbd/scene/measure.hpp"
+#include "grbd/scene/scene.hpp"
+#include "grbd/scene/simulation.hpp"
+
+namespace {
+
+using grbd::Vector3;
+
+const std::string kScenes = GRBD_CH07_SCENE_DIR;
+
+TEST(Experiments, JanssensSiloCarriesItsWeightOnWallsAndFloor) {
+  grbd::scene::Scene scene = grbd::scene::load_scene(kScenes + "/silo.toml");
+  scene.groups.at(0).generator.count = 600;
+  scene.groups.at(0).generator.region.max.z() = 0.085;
+  scene.end_time = 0.4;
+  grbd::scene::Simulation sim(scene);
+  while (!sim.finished()) sim.step();
+
+  const double g = 9.81;
+  double weight = 0.0;
+  for (std::size_t i = 0; i < sim.system().size(); ++i) weight += sim.system().inertia()[i].m * g;
+  const auto& problem = sim.stepper().problem();
+  const auto Lambda = sim.stepper().percussions();
+  const double dt = scene.settings.dt;
+  double mu_w = 0.0;
+  for (const auto& c : scene.contacts) {
+    if (c.a != c.b) mu_w = c.law.mu;
+  }
+  double floor = 0.0, walls = 0.0, wall_normal = 0.0;
+  for (std::size_t c = 0; c < problem.contacts.size(); ++c) {
+    const auto& contact = problem.contacts[c];
+    if (contact.body_b != grbd::collision::kStatic) continue;
+    const Vector3 F = grbd::scene::contact_force(contact, Lambda[c], dt);
+    if (std::abs(contact.n.z()) > 0.5) {
+      floor += F.z();
+    } else {
+      walls += F.z();
+      wall_normal += Lambda[c][0] / dt;
+      // Coulomb at every wall contact: |F_T| ≤ μ_w F_N.
+      EXPECT_LE(std::hypot(Lambda[c][1], Lambda[c][2]), mu_w * Lambda[c][0] * (1.0 + 1e-9) + 1e-15);
+    }
+  }
+  // At rest the static geometry carries the weight (to the solver's tolerance).
+  EXPECT_NEAR((floor + walls) / weight, 1.0, 0.01);
+  // The walls carry a part by friction, at most μ_w of their normal force.
+  EXPECT_GT(walls / weight, 0.05);
+  EXPECT_LT(floor / weight, 0.95);
+  EXPECT_LE(walls / wall_normal, mu_w * (1.0 + 1e-9));
+  EXPECT_GT(walls / wall_normal, 0.0);
+}
+
+TEST(Experiments, BeverlooDischargeFlowsAtBeverloosRate) {
+  grbd::scene::Scene scene = grbd::scene::load_scene(kScenes + "/beverloo.toml");
+  scene.end_time = 0.3;
+  const double D = 0.026;  // the scene's orifice
+  grbd::scene::Simulation sim(scene);
+  std::vector<double> t, m;
+  double rho_b = 0.0;
+  int samples = 0;
+  const grbd::scene::Slices slab{0.035, 0.025, 1, 0.064 * 0.064};
+  while (!sim.finished()) {
+    sim.step();
+    sim.created().clear();
+    t.push_back(sim.stepper().time());
+    m.push_back(sim.mass_removed());
+    if (t.back() >= 0.15 && sim.stepper().steps() % 10 == 0) {
+      rho_b += grbd::scene::slice_masses(sim, slab)[0] / (slab.area * slab.h);
+      ++samples;
+    }
+  }
+  rho_b /= samples;
+  EXPECT_GT(rho_b, 1300.0);  // a packing fraction above 0.52
+  EXPECT_LT(rho_b, 1600.0);  // and below 0.64
+  const grbd::scene::Rate W = grbd::scene::steady_rate(t, m, 0.15);
+  const double beverloo = grbd::scene::beverloo_rate(0.58, 1.5, rho_b, 9.81, D, 0.004);
+  EXPECT_NEAR(W.rate / beverloo, 1.0, 0.2)
+      << "W = " << W.rate << " ± " << W.error << " kg/s, Beverloo " << beverloo << " kg/s";
+  EXPECT_LT(W.error, 0.1 * W.rate);
+}
+
+}  // namespace
