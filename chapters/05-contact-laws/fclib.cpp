@@ -36,17 +36,13 @@
 #include <system_error>
 #include <vector>
 
-#include "grbd/contact/fclib.hpp"
-#include "grbd/contact/solver.hpp"
+#include "grbd/contact/fclib_bench.hpp"
+#include "grbd/core/error.hpp"
 #include "grbd_demo/demo.hpp"
 
 namespace {
 
 namespace fs = std::filesystem;
-using grbd::Vector3;
-using grbd::contact::LocalProblem;
-using grbd::contact::SolverOptions;
-using grbd::contact::SolverResult;
 
 constexpr const char* kProgram = "ch05_fclib";
 constexpr const char* kUsage =
@@ -117,42 +113,6 @@ CLI::Validator finite_positive() {
       "");
 }
 
-/// Adds the FCLIB files that `argument` names to `files`: the file itself, or every *.hdf5 in the
-/// folder, in name order. Returns why it cannot, or std::nullopt. Uses the std::error_code
-/// overloads of std::filesystem throughout: the throwing ones would end the program on a
-/// symbolic-link loop, an overlong name or an unreadable folder.
-std::optional<std::string> collect(const std::string& argument, std::vector<fs::path>& files) {
-  std::error_code error;
-  const fs::file_status status = fs::status(argument, error);
-  if (error) {
-    return "cannot use '" + argument + "' as an FCLIB file or folder: " + error.message();
-  }
-  if (fs::is_directory(status)) {
-    std::vector<fs::path> found;
-    for (fs::directory_iterator entry(argument, error), end; !error && entry != end;
-         entry.increment(error)) {
-      if (entry->path().extension() == ".hdf5") found.push_back(entry->path());
-    }
-    if (error) return "cannot read the folder '" + argument + "': " + error.message();
-    if (found.empty()) return "the folder '" + argument + "' holds no *.hdf5 file";
-    std::sort(found.begin(), found.end());
-    files.insert(files.end(), found.begin(), found.end());
-    return std::nullopt;
-  }
-  if (fs::is_regular_file(status)) {
-    files.emplace_back(argument);
-    return std::nullopt;
-  }
-  return "'" + argument + "' is neither an FCLIB file nor a folder";
-}
-
-struct Run {
-  std::string name;
-  SolverOptions options;
-  bool jor = false;
-  bool apgd = false;
-};
-
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -199,66 +159,33 @@ int main(int argc, char** argv) {
   }
   std::vector<fs::path> files;
   for (const std::string& input : inputs) {
-    if (const auto problem = collect(input, files)) return refuse(*problem);
+    try {
+      const std::vector<fs::path> found = grbd::contact::fclib_files(input);
+      files.insert(files.end(), found.begin(), found.end());
+    } catch (const grbd::Error& e) {
+      return refuse(e.what());
+    }
   }
 
   try {
     grbd::demo::OutputFile table(dir / "fclib.txt");
     grbd::demo::OutputFile history(dir / "fclib.csv", "problem,solver,k,relative_residual");
-    char line[512];
-    std::snprintf(line, sizeof line, "%-44s %-12s %4s %9s %10s %10s %10s %s\n", "problem", "solver",
-                  "n", "iter", "|F|/|q|", "|F|/max", "time [ms]", "");
-    table << line;
-    std::cout << line;
-
-    std::vector<Run> runs(4);
-    for (Run& run : runs) {
-      run.options.criterion = grbd::contact::Criterion::natural_residual;
-      run.options.abs_tol = 0.0;
-      run.options.rel_tol = tol;
-      run.options.max_iterations = max_iterations;
-      run.options.record_history = true;
-    }
-    runs[0].name = "SOR-AC";
-    runs[1].name = "SOR-DS";
-    runs[1].options.form = grbd::contact::ProxForm::de_saxce;
-    runs[2].name = "JOR";
-    runs[2].jor = true;
-    runs[2].options.alpha = 0.5;
-    runs[2].options.r_strategy = grbd::contact::RFactorStrategy::global;
-    runs[3].name = "APGD";
-    runs[3].apgd = true;
-
-    for (const fs::path& file : files) {
-      const grbd::contact::FclibInfo info = grbd::contact::read_fclib_info(file);
-      const LocalProblem problem = grbd::contact::read_fclib_as_local(file);
-      const std::string name = file.stem().string();
-      std::vector<Run> these = runs;
-      if (info.guess) {
-        Run warm = runs[0];
-        warm.name = "SOR-AC warm";
-        these.push_back(warm);
+    table << grbd::contact::fclib_table_header();
+    std::cout << grbd::contact::fclib_table_header();
+    grbd::contact::FclibBenchOptions options;
+    options.tol = tol;
+    options.max_iterations = max_iterations;
+    options.record_history = true;
+    grbd::contact::fclib_bench(files, options, [&](const grbd::contact::FclibBenchRow& row) {
+      table << grbd::contact::fclib_table_line(row);
+      std::cout << grbd::contact::fclib_table_line(row);
+      char line[512];
+      for (std::size_t k = 0; k < row.history.size(); ++k) {
+        std::snprintf(line, sizeof line, "%s,%s,%zu,%.6e\n", row.problem.c_str(),
+                      row.solver.c_str(), k + 1, row.history[k]);
+        history << line;
       }
-      for (const Run& run : these) {
-        std::vector<Vector3> lambda;
-        if (run.name.ends_with("warm")) lambda = *info.guess;
-        const SolverResult result =
-            run.apgd  ? grbd::contact::solve_apgd(problem, lambda, run.options)
-            : run.jor ? grbd::contact::solve_jor(problem, lambda, run.options)
-                      : grbd::contact::solve_sor(problem, lambda, run.options);
-        std::snprintf(line, sizeof line, "%-44s %-12s %4zu %9d %10.2e %10.2e %10.2f %s\n",
-                      name.c_str(), run.name.c_str(), problem.q.size(), result.iterations,
-                      result.relative_residual(), result.scaled_residual(), 1e3 * result.seconds,
-                      result.converged ? "" : "NOT converged");
-        table << line;
-        std::cout << line;
-        for (std::size_t k = 0; k < result.history.size(); ++k) {
-          std::snprintf(line, sizeof line, "%s,%s,%zu,%.6e\n", name.c_str(), run.name.c_str(),
-                        k + 1, result.history[k] / result.norm_c);
-          history << line;
-        }
-      }
-    }
+    });
     table.finish();
     history.finish();
     return 0;

@@ -4,31 +4,47 @@
 //            [--quiet] [--progress auto|bar|lines]
 //   grbd validate <scene.toml>
 //   grbd info <output.h5>
+//   grbd fclib <FCLIB file or folder>... [--tol T] [--max-iterations N] [--csv FILE]
+//   grbd bench [--list] [NAME...] [Google Benchmark options]
 //
 // Exit codes (also in `grbd --help`):
 //   0    done
 //   1    the run failed (a solver diverged, a file could not be written)
 //   2    bad command line
-//   3    bad input: a scene, checkpoint or output file that cannot be used (nothing was run)
+//   3    bad input: a scene, checkpoint, output or FCLIB file that cannot be used (nothing was
+//        run)
 //   130  stopped by SIGINT, 143 by SIGTERM: the step was finished, a checkpoint written and the
 //        output closed; `grbd run <scene> --restart <checkpoint>` continues
 
+#include <spawn.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
+#include <algorithm>
+#include <cerrno>
 #include <chrono>
+#include <cmath>
 #include <csignal>
 #include <cstdio>
+#include <filesystem>
+#include <fstream>
 #include <iomanip>
 #include <iostream>
 #include <optional>
 #include <sstream>
 #include <string>
+#include <system_error>
+#include <utility>
+#include <vector>
 
+#include "grbd/contact/fclib_bench.hpp"
 #include "grbd/io/output.hpp"
 #include "grbd/io/run.hpp"
 #include "grbd/scene/scene.hpp"
 #include "grbd/scene/simulation.hpp"
+
+extern char** environ;  // POSIX: the environment, for posix_spawn
 
 namespace {
 
@@ -38,7 +54,7 @@ constexpr int kExitInput = 3;
 
 constexpr const char* kExitCodes =
     "Exit codes: 0 done; 1 the run failed (solver diverged, file not writable); 2 bad command "
-    "line; 3 bad input (scene, checkpoint or output file), nothing run; 130 / 143 stopped by "
+    "line; 3 bad input (scene, checkpoint, output or FCLIB file), nothing run; 130 / 143 stopped by "
     "SIGINT / SIGTERM after writing a checkpoint (continue with --restart).";
 
 volatile std::sig_atomic_t g_signal = 0;
@@ -230,6 +246,128 @@ int info_command(const std::string& file) {
   }
 }
 
+int fclib_command(const std::vector<std::string>& inputs, double tol, int max_iterations,
+                  const std::optional<std::string>& csv) {
+  std::vector<std::filesystem::path> files;
+  try {
+    for (const std::string& input : inputs) {
+      const auto found = grbd::contact::fclib_files(input);
+      files.insert(files.end(), found.begin(), found.end());
+    }
+  } catch (const grbd::Error& e) {
+    std::cerr << "grbd fclib: " << e.what() << '\n';
+    return kExitInput;
+  }
+  try {
+    std::ofstream history;
+    if (csv) {
+      history.open(*csv);
+      if (!history) {
+        std::cerr << "grbd fclib: cannot open " << *csv << " for writing\n";
+        return kExitFailed;
+      }
+      history << "problem,solver,k,relative_residual\n" << std::setprecision(7);
+    }
+    grbd::contact::FclibBenchOptions options;
+    options.tol = tol;
+    options.max_iterations = max_iterations;
+    options.record_history = csv.has_value();
+    bool header = false;  // printed with the first row: not before a file that is refused
+    grbd::contact::fclib_bench(files, options, [&](const grbd::contact::FclibBenchRow& row) {
+      if (!std::exchange(header, true)) std::cout << grbd::contact::fclib_table_header();
+      std::cout << grbd::contact::fclib_table_line(row) << std::flush;
+      for (std::size_t k = 0; k < row.history.size(); ++k) {
+        history << row.problem << ',' << row.solver << ',' << k + 1 << ',' << row.history[k]
+                << '\n';
+      }
+    });
+    if (csv && !history.flush()) {
+      std::cerr << "grbd fclib: cannot write " << *csv << '\n';
+      return kExitFailed;
+    }
+    return 0;
+  } catch (const grbd::Error& e) {
+    std::cerr << "grbd fclib: " << e.what() << '\n';
+    return kExitInput;  // a file the reader refuses: nothing of it was solved
+  }
+}
+
+// The benchmark programs of the chapters (grbd_add_benchmark) are built into the folder
+// benchmarks/ beside this executable.
+std::filesystem::path benchmark_folder() {
+  std::error_code error;
+  const auto self = std::filesystem::read_symlink("/proc/self/exe", error);
+  return (error ? std::filesystem::path(".") : self.parent_path()) / "benchmarks";
+}
+
+std::vector<std::filesystem::path> benchmarks() {
+  std::vector<std::filesystem::path> found;
+  std::error_code error;
+  for (std::filesystem::directory_iterator entry(benchmark_folder(), error), end;
+       !error && entry != end; entry.increment(error)) {
+    if (entry->is_regular_file() && ::access(entry->path().c_str(), X_OK) == 0) {
+      found.push_back(entry->path());
+    }
+  }
+  std::sort(found.begin(), found.end());
+  return found;
+}
+
+int bench_command(const std::vector<std::string>& names, bool list,
+                  const std::vector<std::string>& pass) {
+  const auto all = benchmarks();
+  if (all.empty()) {
+    std::cerr << "grbd bench: no benchmark programs in " << benchmark_folder()
+              << " (they are built with grbd: cmake --build <build folder>)\n";
+    return kExitFailed;
+  }
+  if (list) {
+    for (const auto& b : all) std::cout << b.filename().string() << '\n';
+    return 0;
+  }
+  // A name selects the programs whose name contains it (ch05, sor, ch06_bench_step).
+  std::vector<std::filesystem::path> chosen;
+  for (const std::string& name : names) {
+    std::size_t matched = 0;
+    for (const auto& b : all) {
+      if (b.filename().string().find(name) != std::string::npos &&
+          std::find(chosen.begin(), chosen.end(), b) == chosen.end()) {
+        chosen.push_back(b);
+        ++matched;
+      }
+    }
+    if (matched == 0) {
+      std::cerr << "grbd bench: no benchmark matches '" << name << "'; grbd bench --list lists "
+                << all.size() << '\n';
+      return kExitUsage;
+    }
+  }
+  if (names.empty()) chosen = all;
+  int status = 0;
+  for (const auto& b : chosen) {
+    std::vector<std::string> args = {b.string()};
+    args.insert(args.end(), pass.begin(), pass.end());
+    std::vector<char*> argv;
+    for (auto& a : args) argv.push_back(a.data());
+    argv.push_back(nullptr);
+    std::cout << "== " << b.filename().string() << std::endl;
+    pid_t pid = 0;
+    if (posix_spawn(&pid, b.c_str(), nullptr, nullptr, argv.data(), environ) != 0) {
+      std::cerr << "grbd bench: cannot start " << b << '\n';
+      return kExitFailed;
+    }
+    int wstatus = 0;
+    while (waitpid(pid, &wstatus, 0) < 0) {
+      if (errno != EINTR) return kExitFailed;
+    }
+    if (!WIFEXITED(wstatus) || WEXITSTATUS(wstatus) != 0) {
+      std::cerr << "grbd bench: " << b.filename().string() << " failed\n";
+      status = kExitFailed;
+    }
+  }
+  return status;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -274,6 +412,42 @@ int main(int argc, char** argv) {
       ->check(CLI::ExistingFile);
   info->footer(kExitCodes);
 
+  std::vector<std::string> fclib_inputs;
+  double fclib_tol = 1e-8;
+  int fclib_max_iterations = 20000;
+  std::optional<std::string> fclib_csv;
+  CLI::App* fclib = app.add_subcommand(
+      "fclib", "Solve FCLIB problems with SOR, JOR and APGD (chapter 5's bench): a table");
+  fclib->add_option("problems", fclib_inputs, "FCLIB files (HDF5), or folders of *.hdf5 files")
+      ->required();
+  fclib->add_option("--tol", fclib_tol, "Stop once |F| <= tol |q| (natural map), default 1e-8")
+      ->check(CLI::Validator(
+          [](const std::string& text) -> std::string {
+            double value = 0.0;
+            if (!CLI::detail::lexical_cast(text, value) || !std::isfinite(value) || !(value > 0.0))
+              return "expected a finite number > 0, found " + text;
+            return {};
+          },
+          "T > 0"));
+  fclib->add_option("--max-iterations", fclib_max_iterations,
+                    "At most this many iterations per solver and problem, default 20000")
+      ->check(CLI::Range(1, 1 << 30));
+  fclib->add_option("--csv", fclib_csv, "Write every iteration's |F|/|q| to this CSV file");
+  fclib->footer(kExitCodes);
+
+  std::vector<std::string> bench_names;
+  bool bench_list = false;
+  CLI::App* bench = app.add_subcommand(
+      "bench", "Run the chapters' Google Benchmark programs; other options go to them");
+  bench->add_option("names", bench_names,
+                    "Run the programs whose names contain these (default: all)");
+  bench->add_flag("--list", bench_list, "List the benchmark programs");
+  bench->allow_extras();
+  bench->footer(
+      "Options it does not know, e.g. --benchmark_filter=REGEX or --benchmark_min_time=0.1s, "
+      "go to every program it runs. " +
+      std::string(kExitCodes));
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
@@ -286,5 +460,7 @@ int main(int argc, char** argv) {
     return run_command(scene_file, output, checkpoint, restart, end_time, quiet, progress);
   if (validate->parsed()) return validate_command(validate_file);
   if (info->parsed()) return info_command(info_file);
+  if (fclib->parsed()) return fclib_command(fclib_inputs, fclib_tol, fclib_max_iterations, fclib_csv);
+  if (bench->parsed()) return bench_command(bench_names, bench_list, bench->remaining());
   return kExitUsage;
 }

@@ -93,7 +93,7 @@ class Scratch(unittest.TestCase):
 
 class Help(Scratch):
     def test_every_subcommand_has_help_with_the_exit_codes(self):
-        for sub in ([], ["run"], ["validate"], ["info"]):
+        for sub in ([], ["run"], ["validate"], ["info"], ["fclib"], ["bench"]):
             result = run(*sub, "--help")
             self.assertEqual(result.returncode, 0, result.stderr)
             self.assertIn("Exit codes", result.stdout)
@@ -333,6 +333,68 @@ class Signals(Scratch):
             self.assertEqual(result.returncode, 0, result.stderr)
             self.assertSameOutput(reference, out)
             self.assertFalse(os.path.exists(ckpt + ".tmp") and os.path.getsize(ckpt + ".tmp") == 0)
+
+
+# The FCLIB problems shipped with chapter 5.
+FCLIB_DATA = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "chapters",
+                          "05-contact-laws", "data")
+
+
+class Fclib(Scratch):
+    def test_fclib_solves_a_problem_with_every_solver_to_the_tolerance(self):
+        problem = os.path.join(FCLIB_DATA, "Spheres-i099-356-679.hdf5")
+        csv = self.path("history.csv")
+        result = run("fclib", problem, "--tol", "1e-6", "--csv", csv)
+        self.assertEqual(result.returncode, 0, result.stderr)
+        rows = [line.split() for line in result.stdout.splitlines()[1:]]
+        solvers = [" ".join(r[1:-5]) for r in rows]
+        self.assertEqual(solvers, ["SOR-AC", "SOR-DS", "JOR", "APGD", "SOR-AC warm"])
+        for r in rows:
+            self.assertEqual(r[0], "Spheres-i099-356-679")
+            self.assertEqual(int(r[-5]), 356)          # contacts
+            self.assertLessEqual(float(r[-3]), 1e-6)   # |F|/|q|
+        self.assertNotIn("NOT converged", result.stdout)
+        with open(csv) as f:
+            lines = f.read().splitlines()
+        self.assertEqual(lines[0], "problem,solver,k,relative_residual")
+        total = sum(int(r[-4]) for r in rows)          # one line per iteration of every solve
+        self.assertEqual(len(lines) - 1, total)
+        last = float(lines[-1].split(",")[3])
+        self.assertLessEqual(last, 1e-6)
+
+    def test_fclib_refuses_bad_problems_and_options(self):
+        text = self.path("not.hdf5")
+        with open(text, "w") as f:
+            f.write("not an HDF5 file\n")
+        for args, code, message in (
+                (["/nonexistent"], 3, "/nonexistent"),
+                ([text], 3, "not.hdf5"),
+                ([self.dir], 3, "not.hdf5"),  # a folder: its *.hdf5 files are read
+                (["--tol", "-1", FCLIB_DATA], 2, "--tol"),
+                (["--tol", "nan", FCLIB_DATA], 2, "--tol"),
+                (["--max-iterations", "0", FCLIB_DATA], 2, "--max-iterations")):
+            result = run("fclib", *args)
+            self.assertEqual(result.returncode, code, (args, result.stderr))
+            self.assertIn(message, result.stderr)
+            self.assertEqual(result.stdout, "")
+
+
+class Bench(Scratch):
+    def test_bench_lists_runs_and_passes_options_on(self):
+        result = run("bench", "--list")
+        self.assertEqual(result.returncode, 0, result.stderr)
+        names = result.stdout.split()
+        for name in ("ch02_bench_integrators", "ch04_bench_broad_phase", "ch05_bench_sor",
+                     "ch06_bench_step"):
+            self.assertIn(name, names)
+        # --benchmark_list_tests goes to the program, which lists its benchmarks and exits 0.
+        result = run("bench", "ch02", "--benchmark_list_tests=true")
+        self.assertEqual(result.returncode, 0, result.stderr)
+        self.assertIn("== ch02_bench_integrators", result.stdout)
+        self.assertGreater(len(result.stdout.splitlines()), 2)
+        result = run("bench", "no_such_benchmark")
+        self.assertEqual(result.returncode, 2)
+        self.assertIn("no_such_benchmark", result.stderr)
 
 
 if __name__ == "__main__":
