@@ -112,20 +112,15 @@ Discharge discharge(const grbd::scene::Scene& base, double D, double t_start, do
 }  // namespace
 
 int main(int argc, char** argv) {
-  if (grbd::demo::wants_help(argc, argv) || argc < 3) {
-    (argc < 3 && !grbd::demo::wants_help(argc, argv) ? std::cerr : std::cout)
-        << "usage: " << kProgram << " <data directory> <scene.toml> [end_time t_start D_mm...]\n"
-        << "  runs Beverloo's silo for each orifice diameter and fits C and k; writes "
-           "discharge.csv, beverloo.csv and beverloo.txt\n";
-    return grbd::demo::wants_help(argc, argv) ? 0 : 2;
+  if (const auto exit = grbd::demo::check_arguments(
+          argc, argv, kProgram, {"<data directory>", "<scene.toml>", "[end_time t_start D_mm...]"},
+          "runs Beverloo's silo for each orifice diameter and fits C and k; writes discharge.csv, "
+          "beverloo.csv, beverloo_curve.csv and beverloo.txt",
+          2, static_cast<std::size_t>(argc))) {
+    return *exit;
   }
   try {
     const std::filesystem::path dir = argv[1];
-    if (const auto reason = grbd::demo::not_a_directory(dir)) {
-      std::cerr << kProgram << ": " << grbd::demo::directory_message("data directory", dir, *reason)
-                << '\n';
-      return 2;
-    }
     grbd::scene::Scene scene = grbd::scene::load_scene(argv[2]);
     double t_start = 0.2;
     std::vector<double> sizes = {0.020, 0.024, 0.028, 0.032};

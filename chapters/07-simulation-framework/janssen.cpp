@@ -141,20 +141,15 @@ Analysis analyse(const grbd::scene::Simulation& sim) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  if (grbd::demo::wants_help(argc, argv) || argc < 3 || argc > 4) {
-    (argc < 3 && !grbd::demo::wants_help(argc, argv) ? std::cerr : std::cout)
-        << "usage: " << kProgram << " <data directory> <scene.toml> [end_time]\n"
-        << "  runs Janssen's silo and fits the Janssen length; writes silo.h5, silo.xmf, "
-           "janssen.csv and janssen.txt\n";
-    return grbd::demo::wants_help(argc, argv) ? 0 : 2;
+  if (const auto exit = grbd::demo::check_arguments(
+          argc, argv, kProgram, {"<data directory>", "<scene.toml>", "[end_time]"},
+          "runs Janssen's silo and fits the Janssen length; writes silo.h5, silo.xmf, janssen.csv "
+          "and janssen.txt",
+          2, 3)) {
+    return *exit;
   }
   try {
     const std::filesystem::path dir = argv[1];
-    if (const auto reason = grbd::demo::not_a_directory(dir)) {
-      std::cerr << kProgram << ": " << grbd::demo::directory_message("data directory", dir, *reason)
-                << '\n';
-      return 2;
-    }
     grbd::scene::Scene scene = grbd::scene::load_scene(argv[2]);
     if (argc == 4) scene.end_time = std::stod(argv[3]);
     grbd::io::RunOptions options;

@@ -52,14 +52,16 @@ inline std::string directory_message(std::string_view what, const std::filesyste
   return "cannot use the " + std::string(what) + " '" + path.string() + "': " + std::string(reason);
 }
 
-/// Checks `program <data directory> [further arguments]`: exactly arguments.size() arguments, the
-/// first an existing directory. `arguments` names them for the usage line, `writes` says what the
-/// demo writes. Returns std::nullopt when main should go on; otherwise the exit code main returns:
-/// 0 after printing the usage to std::cout for `-h` or `--help`, 2 after printing the usage or the
+/// Checks `program <data directory> [further arguments]`: from `least` (at least 1) to `most`
+/// arguments, the first an existing directory. `arguments` names them for the usage line (the
+/// optional ones in brackets; the last may stand for several), `writes` says what the demo
+/// writes. Returns std::nullopt when main should go on; otherwise the exit code main returns: 0
+/// after printing the usage to std::cout for `-h` or `--help`, 2 after printing the usage or the
 /// problem to std::cerr. The program is named by `program`, never by the path it was started with.
 inline std::optional<int> check_arguments(int argc, char** argv, std::string_view program,
                                           std::initializer_list<std::string_view> arguments,
-                                          std::string_view writes) {
+                                          std::string_view writes, std::size_t least,
+                                          std::size_t most) {
   const auto print_usage = [&](std::ostream& out) {
     out << "usage: " << program;
     for (const std::string_view argument : arguments) out << ' ' << argument;
@@ -69,7 +71,8 @@ inline std::optional<int> check_arguments(int argc, char** argv, std::string_vie
     print_usage(std::cout);
     return 0;
   }
-  if (argc != static_cast<int>(arguments.size()) + 1) {
+  if (argc < 2 || static_cast<std::size_t>(argc - 1) < least ||
+      static_cast<std::size_t>(argc - 1) > most) {
     print_usage(std::cerr);
     return 2;
   }
@@ -78,6 +81,14 @@ inline std::optional<int> check_arguments(int argc, char** argv, std::string_vie
     return 2;
   }
   return std::nullopt;
+}
+
+/// check_arguments() for exactly arguments.size() arguments.
+inline std::optional<int> check_arguments(int argc, char** argv, std::string_view program,
+                                          std::initializer_list<std::string_view> arguments,
+                                          std::string_view writes) {
+  return check_arguments(argc, argv, program, arguments, writes, arguments.size(),
+                         arguments.size());
 }
 
 /// A file a demo writes: a std::ofstream that knows its path and reports every failure as a
