@@ -62,6 +62,12 @@ TEST(Experiments, JanssensSiloCarriesItsWeightOnWallsAndFloor) {
 }
 
 TEST(Experiments, BeverlooDischargeFlowsAtBeverloosRate) {
+  // The measurement (Exercise 7.4) first: a student build without it stops here, not after the
+  // 20 s of the run.
+  ASSERT_EQ(grbd::scene::steady_rate(std::vector<double>{0, 1, 2, 3},
+                                     std::vector<double>{0, 2, 4, 6}, 0.0, 2)
+                .rate,
+            2.0);
   grbd::scene::Scene scene = grbd::scene::load_scene(kScenes + "/beverloo.toml");
   scene.end_time = 0.3;
   const double D = 0.026;  // the scene's orifice
