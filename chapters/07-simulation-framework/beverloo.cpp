@@ -64,28 +64,12 @@ grbd::scene::Scene with_orifice(const grbd::scene::Scene& base, double D) {
 }
 // [beverloo floor]
 
-// The side of the square silo: the distance between its side walls (half-spaces with a
-// horizontal normal along x).
-double silo_width(const grbd::scene::Scene& scene) {
-  double lo = INFINITY, hi = -INFINITY;
-  for (const auto& s : scene.statics) {
-    const auto* plane = std::get_if<grbd::collision::HalfSpace>(&s.shape);
-    if (plane != nullptr && std::abs(plane->I_n.x()) > 0.99) {
-      const double x = -plane->offset / plane->I_n.x();
-      lo = std::min(lo, x);
-      hi = std::max(hi, x);
-    }
-  }
-  if (!(hi > lo)) throw grbd::Error(scene.file.string() + ": expected two side walls along x");
-  return hi - lo;
-}
-
 Discharge discharge(const grbd::scene::Scene& base, double D, double t_start, double slab_lo,
                     double slab_hi) {
   Discharge out;
   out.D = D;
   const grbd::scene::Scene scene = with_orifice(base, D);
-  const double width = silo_width(scene);
+  const double width = grbd::scene::silo_width(scene);
   const grbd::scene::Slices slab{slab_lo, slab_hi - slab_lo, 1, width * width};
   grbd::scene::Simulation sim(scene);
   std::size_t samples = 0;
@@ -185,9 +169,10 @@ int main(int argc, char** argv) {
     curve.finish();
     std::ostringstream text;
     text << std::setprecision(4) << kProgram << ": d = " << d * 1e3 << " mm, silo width "
-         << silo_width(scene) * 1e3 << " mm, " << runs.size() << " orifices; fitted C = " << fit.C
-         << ", k = " << fit.k << " (rms " << fit.rms * 100.0 << " %), against C = " << kLiteratureC
-         << ", k = " << kLiteratureK << " (Beverloo et al. 1961)\n";
+         << grbd::scene::silo_width(scene) * 1e3 << " mm, " << runs.size()
+         << " orifices; fitted C = " << fit.C << ", k = " << fit.k << " (rms " << fit.rms * 100.0
+         << " %), against C = " << kLiteratureC << ", k = " << kLiteratureK
+         << " (Beverloo et al. 1961)\n";
     std::cout << text.str();
     grbd::demo::OutputFile summary(dir / "beverloo.txt");
     summary << text.str();

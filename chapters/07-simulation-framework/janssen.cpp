@@ -47,17 +47,7 @@ struct Analysis {
 Analysis analyse(const grbd::scene::Simulation& sim) {
   Analysis out;
   const auto& scene = sim.scene();
-  // The silo: the side walls are the static half-spaces with horizontal normals.
-  double x_min = INFINITY, x_max = -INFINITY;
-  for (const auto& s : scene.statics) {
-    const auto* plane = std::get_if<grbd::collision::HalfSpace>(&s.shape);
-    if (plane != nullptr && std::abs(plane->I_n.x()) > 0.99) {
-      const double x = -plane->offset / plane->I_n.x();
-      x_min = std::min(x_min, x);
-      x_max = std::max(x_max, x);
-    }
-  }
-  out.D = x_max - x_min;
+  out.D = grbd::scene::silo_width(scene);
   const double area = out.D * out.D;
   double mean_diameter = 0.0, mass = 0.0, z_top = 0.0;
   const auto states = sim.system().states();

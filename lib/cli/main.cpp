@@ -288,7 +288,7 @@ int fclib_command(const std::vector<std::string>& inputs, double tol, int max_it
     return 0;
   } catch (const grbd::Error& e) {
     std::cerr << "grbd fclib: " << e.what() << '\n';
-    return kExitInput;  // a file the reader refuses: nothing of it was solved
+    return kExitInput;  // a file the reader refuses (the files before it were solved)
   }
 }
 

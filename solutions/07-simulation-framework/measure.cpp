@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <string>
+#include <variant>
 
 #include "grbd/core/checks.hpp"
 #include "grbd/core/error.hpp"
@@ -47,6 +48,23 @@ std::size_t Slices::slice_of(double z) const {
   const double k = std::floor((z - z0) / h);
   if (!(k >= 0.0) || k >= static_cast<double>(count)) return count;
   return static_cast<std::size_t>(k);
+}
+
+double silo_width(const Scene& scene) {
+  double lo = INFINITY, hi = -INFINITY;
+  for (const auto& s : scene.statics) {
+    const auto* plane = std::get_if<collision::HalfSpace>(&s.shape);
+    if (plane != nullptr && std::abs(plane->I_n.x()) > 0.99) {
+      const double x = -plane->offset / plane->I_n.x();
+      lo = std::min(lo, x);
+      hi = std::max(hi, x);
+    }
+  }
+  if (!(hi > lo)) {
+    throw InvalidArgument(scene.file.string() +
+                          ": expected two static half-spaces with normals along x (side walls)");
+  }
+  return hi - lo;
 }
 
 Vector3 contact_force(const contact::CompactContact& contact, const Vector3& Lambda, double dt) {

@@ -4,7 +4,6 @@
 // bit; checkpoints replace each other atomically; damaged files are refused with their name.
 
 #include <gtest/gtest.h>
-#include <unistd.h>
 
 #include <filesystem>
 #include <fstream>
@@ -15,6 +14,7 @@
 #include "grbd/io/run.hpp"
 #include "grbd/scene/scene.hpp"
 #include "grbd/scene/simulation.hpp"
+#include "grbd_test/temp_dir.hpp"
 
 namespace {
 
@@ -22,22 +22,12 @@ namespace fs = std::filesystem;
 using grbd::io::IoError;
 using grbd::scene::Simulation;
 
-// A folder of its own for each test.
+// A folder of its own for each test (unique per process too: the student build's test program,
+// run by the honesty check, runs the same tests at the same time).
 class Folder : public ::testing::Test {
  protected:
-  void SetUp() override {
-    // The process id too: the student build's test program (the honesty check) runs the same
-    // tests at the same time.
-    dir_ =
-        fs::temp_directory_path() /
-        ("grbd_io_" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()) +
-         "_" + std::to_string(::getpid()));
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
   fs::path path(const std::string& name) const { return dir_ / name; }
-  fs::path dir_;
+  grbd::test::TempDir dir_;
 };
 
 grbd::scene::Scene chute() {
@@ -147,10 +137,7 @@ TEST_F(Folder, CheckpointsReplaceEachOtherAtomically) {
   grbd::io::write_checkpoint(path("c.h5"), {sim.save(), {}, scene.text});
   for (int k = 0; k < 20; ++k) sim.step();
   // A crash while writing the next one leaves its temporary file: the previous one is intact.
-  {
-    std::ofstream partial(path("c.h5.tmp"), std::ios::binary);
-    partial << "\x89HDF\r\n\x1a\n half a checkpoint";
-  }
+  dir_.write("c.h5.tmp", "\x89HDF\r\n\x1a\n half a checkpoint");
   EXPECT_EQ(grbd::io::read_checkpoint(path("c.h5")).state.steps, 0U);
   // The next write replaces both.
   grbd::io::write_checkpoint(path("c.h5"), {sim.save(), {}, scene.text});
@@ -177,19 +164,14 @@ TEST_F(Folder, DamagedCheckpointsAreRefusedWithTheirName) {
     return std::string();
   };
   EXPECT_EQ(message(path("missing.h5")), path("missing.h5").string() + ": no such checkpoint file");
-  {
-    std::ofstream text(path("text.h5"));
-    text << "not HDF5\n";
-  }
+  dir_.write("text.h5", "not HDF5\n");
   EXPECT_EQ(message(path("text.h5")), path("text.h5").string() + ": is not an HDF5 file");
   // Cut short: every prefix of the file is refused with an IoError.
   std::ifstream in(path("c.h5"), std::ios::binary);
   const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   for (const double fraction : {0.1, 0.5, 0.9, 0.99}) {
     const auto n = static_cast<std::size_t>(fraction * static_cast<double>(bytes.size()));
-    std::ofstream cut(path("cut.h5"), std::ios::binary | std::ios::trunc);
-    cut.write(bytes.data(), static_cast<std::streamsize>(n));
-    cut.close();
+    dir_.write("cut.h5", bytes.substr(0, n));
     const std::string m = message(path("cut.h5"));
     EXPECT_EQ(m.rfind(path("cut.h5").string() + ": ", 0), 0U) << fraction << ": " << m;
   }

@@ -248,6 +248,21 @@ TEST(BeverlooFit, RefusesPointsItCannotFit) {
   EXPECT_EQ(grbd::scene::beverloo_rate(0.58, 1.5, 1450.0, 9.81, 0.005, 0.004), 0.0);
 }
 
+// The silo of silo.toml has side walls at x = ±15 mm; the column of spheres has none.
+TEST(SiloWidth, IsTheDistanceOfTheSideWalls) {
+  const grbd::scene::Scene silo =
+      grbd::scene::load_scene(std::string(GRBD_CH07_SCENE_DIR) + "/silo.toml");
+  EXPECT_NEAR(grbd::scene::silo_width(silo), 0.030, 1e-15);
+  const grbd::scene::Scene stack = grbd::scene::parse_scene(stack_scene(2, 0.001), "stack.toml");
+  try {
+    grbd::scene::silo_width(stack);
+    ADD_FAILURE() << "a scene without side walls has no width";
+  } catch (const InvalidArgument& e) {
+    EXPECT_EQ(std::string(e.what()),
+              "stack.toml: expected two static half-spaces with normals along x (side walls)");
+  }
+}
+
 // Stresses made from Janssen's law with λ = 40 mm give λ back.
 TEST(JanssenFit, StressesOfJanssensLawGiveBackTheirLength) {
   const double weight = 1350.0 * 9.81, lambda = 0.04;

@@ -55,6 +55,20 @@ std::vector<RadiusDistribution> examples() {
                                                  {1.3681, 1.9913, 0.29116, 0.03956})};
 }
 
+// Truncated normals N(mean, sd²) on [lo, hi]: around the mean, far in the upper tail, entirely
+// below the mean, and narrow; with the unnormalised density exp(−z²/2), z = (r − mean)/sd.
+struct NormalCase {
+  double mean, sd, lo, hi;
+  double density(double r) const {
+    const double z = (r - mean) / sd;
+    return std::exp(-0.5 * z * z);
+  }
+};
+constexpr NormalCase kNormalCases[] = {{1e-3, 0.1e-3, 0.8e-3, 1.3e-3},
+                                       {1e-3, 0.1e-3, 1.3e-3, 1.5e-3},
+                                       {1e-3, 0.5e-3, 0.1e-3, 0.4e-3},
+                                       {1e-3, 1e-5, 0.9e-3, 1.1e-3}};
+
 TEST(RadiusDistribution, UniformMomentsAreTheClosedForms) {
   const double a = 0.9e-3;
   const double b = 1.1e-3;
@@ -70,16 +84,9 @@ TEST(RadiusDistribution, UniformMomentsAreTheClosedForms) {
 // The moments of the truncated normal from the recurrence of its standard moments, against
 // Simpson quadrature of r^j φ((r − μ)/σ) / (σ Z) over [lo, hi], also far in the upper tail.
 TEST(RadiusDistribution, TruncatedNormalMomentsAgreeWithQuadrature) {
-  struct Case {
-    double mean, sd, lo, hi;
-  };
-  for (const Case c : {Case{1e-3, 0.1e-3, 0.8e-3, 1.3e-3}, Case{1e-3, 0.1e-3, 1.3e-3, 1.5e-3},
-                       Case{1e-3, 0.5e-3, 0.1e-3, 0.4e-3}, Case{1e-3, 1e-5, 0.9e-3, 1.1e-3}}) {
+  for (const NormalCase& c : kNormalCases) {
     const RadiusDistribution d = RadiusDistribution::truncated_normal(c.mean, c.sd, c.lo, c.hi);
-    const auto density = [&](double r) {
-      const double z = (r - c.mean) / c.sd;
-      return std::exp(-0.5 * z * z);
-    };
+    const auto density = [&](double r) { return c.density(r); };
     const double Z = simpson(density, c.lo, c.hi, 20000);
     for (int j = 1; j <= 3; ++j) {
       const double expected =
@@ -122,11 +129,7 @@ TEST(RadiusDistribution, TheReferenceChuteDistributionHasItsIntervalProbabilitie
 // far in the upper tail where Φ ≈ 1; its median agrees with the median of the density found by
 // Simpson quadrature and bisection, an independent reference; samples pass Kolmogorov–Smirnov.
 TEST(Exercise7_1, TruncatedNormalQuantileInvertsTheCdfAlsoInTheUpperTail) {
-  struct Case {
-    double mean, sd, lo, hi;
-  };
-  for (const Case c : {Case{1e-3, 0.1e-3, 0.8e-3, 1.3e-3}, Case{1e-3, 0.1e-3, 1.3e-3, 1.5e-3},
-                       Case{1e-3, 0.5e-3, 0.1e-3, 0.4e-3}, Case{1e-3, 1e-5, 0.9e-3, 1.1e-3}}) {
+  for (const NormalCase& c : kNormalCases) {
     const RadiusDistribution d = RadiusDistribution::truncated_normal(c.mean, c.sd, c.lo, c.hi);
     for (double u = 0.0; u <= 1.0; u += 0.0625) {
       const double r = d.quantile(u);
@@ -136,10 +139,7 @@ TEST(Exercise7_1, TruncatedNormalQuantileInvertsTheCdfAlsoInTheUpperTail) {
     }
     EXPECT_NEAR(d.quantile(0.0), c.lo, 1e-12 * c.lo);
     EXPECT_NEAR(d.quantile(1.0), c.hi, 1e-12 * c.hi);
-    const auto density = [&](double r) {
-      const double z = (r - c.mean) / c.sd;
-      return std::exp(-0.5 * z * z);
-    };
+    const auto density = [&](double r) { return c.density(r); };
     const double Z = simpson(density, c.lo, c.hi, 20000);
     double a = c.lo, b = c.hi;
     for (int i = 0; i < 60; ++i) {

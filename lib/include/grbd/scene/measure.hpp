@@ -24,6 +24,11 @@ struct Slices {
   std::size_t slice_of(double z) const;
 };
 
+/// The width of a silo along x: the distance between the static half-spaces whose normals lie
+/// along ±x (its side walls). Throws InvalidArgument, naming the scene file, unless the scene has
+/// two such planes at different places.
+double silo_width(const Scene& scene);
+
 /// The force of a contact on its side a over the last step, from its percussion
 /// Λ = (Λ_N, Λ_T1, Λ_T2): F = (n Λ_N + t1 Λ_T1 + t2 Λ_T2)/Δt [N].
 Vector3 contact_force(const contact::CompactContact& contact, const Vector3& Lambda, double dt);
