@@ -108,11 +108,11 @@ int main(int argc, char** argv) {
     grbd::scene::Scene scene = grbd::scene::load_scene(argv[2]);
     double t_start = 0.2;
     std::vector<double> sizes = {0.020, 0.024, 0.028, 0.032};
-    if (argc >= 4) scene.end_time = std::stod(argv[3]);
-    if (argc >= 5) t_start = std::stod(argv[4]);
+    if (argc >= 4) scene.end_time = grbd::demo::parse_number(argv[3], "end_time");
+    if (argc >= 5) t_start = grbd::demo::parse_number(argv[4], "t_start");
     if (argc >= 6) {
       sizes.clear();
-      for (int i = 5; i < argc; ++i) sizes.push_back(1e-3 * std::stod(argv[i]));
+      for (int i = 5; i < argc; ++i) sizes.push_back(1e-3 * grbd::demo::parse_number(argv[i], "D_mm"));
     }
     // The mean diameter of the fill's distribution, and the slab of the bulk density: the upper
     // half of the bed, clear of the orifice's flowing zone and of the inflow region.

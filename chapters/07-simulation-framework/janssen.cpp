@@ -141,7 +141,7 @@ int main(int argc, char** argv) {
   try {
     const std::filesystem::path dir = argv[1];
     grbd::scene::Scene scene = grbd::scene::load_scene(argv[2]);
-    if (argc == 4) scene.end_time = std::stod(argv[3]);
+    if (argc == 4) scene.end_time = grbd::demo::parse_number(argv[3], "end_time");
     grbd::io::RunOptions options;
     options.output = dir / "silo.h5";
     options.checkpoint = dir / "silo.ckpt.h5";

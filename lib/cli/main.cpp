@@ -168,6 +168,9 @@ int run_command(const std::string& scene_file, const std::optional<std::string>&
     started = true;
     if (!quiet) display.update(sim, r);
   };
+  options.on_warning = [&](const std::string& warning) {
+    std::cerr << "grbd run: warning: " << warning << '\n';
+  };
   install_handlers();
   options.stop = &g_signal;
   grbd::io::RunResult result;

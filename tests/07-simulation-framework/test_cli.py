@@ -201,7 +201,8 @@ class Output(Scratch):
         scene = self.path("float.toml")
         with open(scene, "w") as f:
             f.write(text.replace("every = 25\n", 'every = 25\nprecision = "float"\n'))
-        result = run("run", scene, "-q", "-o", self.path("f.h5"), "--end-time", "0.05")
+        result = run("run", scene, "-q", "-o", self.path("f.h5"), "-c", self.path("f.ckpt.h5"),
+                     "--end-time", "0.05")
         self.assertEqual(result.returncode, 0, result.stderr)
         with h5py.File(self.path("f.h5"), "r") as f:
             self.assertEqual(f["records/000001/I_r_S"].dtype, np.float32)
@@ -245,9 +246,40 @@ class Restart(Scratch):
         self.assertEqual(first.returncode, 0, first.stderr)
         second = run("run", SCENE, "-q", "-o", out, "-c", ckpt, "--restart", ckpt)
         self.assertEqual(second.returncode, 0, second.stderr)
+        self.assertNotIn("warning", second.stderr)  # the same scene
         n = self.assertSameOutput(reference, out)
+        with h5py.File(out, "r") as f:
+            self.assertEqual(int(f.attrs["restarts"]), 1)
+            self.assertRegex(f.attrs["restart_date"], r"^\d{4}-\d\d-\d\dT\d\d:\d\d:\d\dZ$")
+            self.assertEqual(f.attrs["restart_host"], f.attrs["host"])
         self.assertGreater(n, 50)
+        # The XDMF: appended record by record in one run, written whole at the restart and
+        # appended to after it; the same text either way (but for the HDF5 file's name).
+        def xdmf(h5):
+            with open(h5[:-3] + ".xmf") as f:
+                return f.read().replace(os.path.basename(h5) + ":", "OUTPUT:")
+        self.assertEqual(xdmf(out), xdmf(reference))
+        self.assertGreater(xdmf(out).count("<Grid Name=\"record"), 10)
 
+
+    def test_a_restart_with_a_changed_scene_warns_naming_the_line(self):
+        out, ckpt = self.path("w.h5"), self.path("w.ckpt.h5")
+        first = run("run", SCENE, "-q", "-o", out, "-c", ckpt, "--end-time", "0.05")
+        self.assertEqual(first.returncode, 0, first.stderr)
+        with open(SCENE) as f:
+            lines = f.read().split("\n")
+        k = next(i for i, line in enumerate(lines) if line.startswith("mu = "))
+        changed = lines[:k] + ["mu = 0.25"] + lines[k + 1:]
+        scene = self.path("changed.toml")
+        with open(scene, "w") as f:
+            f.write("\n".join(changed))
+        second = run("run", scene, "-q", "-o", out, "-c", ckpt, "--restart", ckpt,
+                     "--end-time", "0.06")
+        self.assertEqual(second.returncode, 0, second.stderr)
+        self.assertIn("grbd run: warning: %s:%d: the scene differs" % (scene, k + 1), second.stderr)
+        self.assertIn('it has "mu = 0.25", the checkpoint\'s has "%s"' % lines[k], second.stderr)
+        with h5py.File(out, "r") as f:
+            self.assertEqual(int(f.attrs["restarts"]), 1)
 
     def test_restarting_a_finished_run_changes_nothing(self):
         out, ckpt = self.path("f.h5"), self.path("f.ckpt.h5")

@@ -8,6 +8,7 @@
 /// the argument checks add it, so the messages of the exceptions a demo throws never start with it.
 
 #include <cerrno>
+#include <cmath>
 #include <exception>
 #include <filesystem>
 #include <fstream>
@@ -89,6 +90,23 @@ inline std::optional<int> check_arguments(int argc, char** argv, std::string_vie
                                           std::string_view writes) {
   return check_arguments(argc, argv, program, arguments, writes, arguments.size(),
                          arguments.size());
+}
+
+/// A number on a demo's command line: the whole of `text` must be a finite decimal number, else
+/// grbd::Error names the argument (`what`), what was expected and what was found.
+inline double parse_number(std::string_view text, std::string_view what) {
+  const std::string copy(text);
+  std::size_t used = 0;
+  double value = 0.0;
+  try {
+    value = std::stod(copy, &used);
+  } catch (const std::exception&) {
+    used = 0;
+  }
+  if (used == 0 || used != copy.size() || !std::isfinite(value)) {
+    throw Error(std::string(what) + ": expected a finite number, found \"" + copy + "\"");
+  }
+  return value;
 }
 
 /// A file a demo writes: a std::ofstream that knows its path and reports every failure as a

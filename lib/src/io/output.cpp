@@ -114,6 +114,9 @@ struct OutputFile::Impl {
   // What the XDMF lists: time and body count of each complete record.
   std::vector<double> times;
   std::vector<std::uint64_t> counts;
+  // The XDMF file, open to append records over its footer, which starts at xdmf_footer.
+  std::fstream xdmf;
+  std::streamoff xdmf_footer = 0;
   // Scratch of a record.
   std::vector<std::size_t> order;
   std::vector<std::uint64_t> ids;
@@ -213,6 +216,12 @@ OutputFile::OutputFile(const std::filesystem::path& path, const scene::Scene& sc
                  0, o.times, o.file);
   h5::read_array(o.records.get(), "bodies", H5T_NATIVE_UINT64,
                  static_cast<std::int64_t>(at.records), 0, o.counts, o.file);
+  // Who continued the run, and when: the creation's host and date stay as they are.
+  const std::uint64_t restarts =
+      H5Aexists(root, "restarts") > 0 ? h5::read_uint(root, "restarts", o.file) : 0;
+  h5::write_attribute(root, "restarts", restarts + 1, o.file);
+  h5::write_attribute(root, "restart_host", host_name(), o.file);
+  h5::write_attribute(root, "restart_date", utc_now(), o.file);
   check(H5Fflush(root, H5F_SCOPE_LOCAL), o.file, "cannot flush");
   written_ = at;
   write_xdmf();
@@ -347,7 +356,7 @@ void OutputFile::write_record(scene::Simulation& simulation) {
   written_.records = index + 1;
   o.times.push_back(t);
   o.counts.push_back(bodies);
-  write_xdmf();
+  append_xdmf();
 }
 
 void OutputFile::close(scene::Simulation& simulation) {
@@ -361,12 +370,53 @@ void OutputFile::close(scene::Simulation& simulation) {
     h->close();
   }
   if (!o.handle.close()) h5::fail(o.file, "cannot close the output file");
+  o.xdmf.close();
+  if (o.xdmf.fail()) throw IoError(xdmf_path(o.path).string() + ": cannot close the XDMF file");
 }
 
-void OutputFile::write_xdmf() const {
-  const Impl& o = *impl_;
+namespace {
+
+constexpr std::string_view kXdmfFooter = "  </Grid>\n </Domain>\n</Xdmf>\n";
+
+// The XDMF grid of record k with n bodies at time t: points with their radius, velocity,
+// angular velocity and id, all datasets of the record's HDF5 group.
+void write_xdmf_grid(std::ostream& x, const std::string& h5_name, bool float32, std::uint64_t k,
+                     double t, std::uint64_t n) {
+  const char* precision = float32 ? "4" : "8";
+  const std::string base = h5_name + ":/records/" + record_name(k) + "/";
+  auto item = [&](const std::string& dims, const char* type, const char* bytes,
+                  const std::string& dataset) {
+    x << "     <DataItem Dimensions=\"" << dims << "\" NumberType=\"" << type << "\" Precision=\""
+      << bytes << "\" Format=\"HDF\">" << base << dataset << "</DataItem>\n";
+  };
+  const std::string vector = std::to_string(n) + " 3";
+  const std::string scalar = std::to_string(n);
+  auto attribute = [&](const char* name, const char* kind, const std::string& dims,
+                       const char* type, const char* bytes, const std::string& dataset) {
+    x << "    <Attribute Name=\"" << name << "\" AttributeType=\"" << kind
+      << "\" Center=\"Node\">\n";
+    item(dims, type, bytes, dataset);
+    x << "    </Attribute>\n";
+  };
+  x << "   <Grid Name=\"record " << record_name(k) << "\" GridType=\"Uniform\">\n"
+    << "    <Time Value=\"" << t << "\"/>\n"
+    << "    <Topology TopologyType=\"Polyvertex\" NumberOfElements=\"" << n
+    << "\" NodesPerElement=\"1\"/>\n"
+    << "    <Geometry GeometryType=\"XYZ\">\n";
+  item(vector, "Float", precision, "I_r_S");
+  x << "    </Geometry>\n";
+  attribute("radius", "Scalar", scalar, "Float", precision, "radius");
+  attribute("velocity", "Vector", vector, "Float", precision, "I_v_S");
+  attribute("angular_velocity_K", "Vector", vector, "Float", precision, "K_omega");
+  attribute("id", "Scalar", scalar, "UInt", "8", "id");
+  x << "   </Grid>\n";
+}
+
+}  // namespace
+
+void OutputFile::write_xdmf() {
+  Impl& o = *impl_;
   const std::string h5_name = o.path.filename().string();
-  const char* precision = o.float32 ? "4" : "8";
   std::ostringstream x;
   x.precision(17);
   x << "<?xml version=\"1.0\" ?>\n"
@@ -375,40 +425,34 @@ void OutputFile::write_xdmf() const {
     << " <Domain>\n"
     << "  <Grid Name=\"bodies\" GridType=\"Collection\" CollectionType=\"Temporal\">\n";
   for (std::size_t k = 0; k < o.times.size(); ++k) {
-    const std::uint64_t n = o.counts[k];
-    if (n == 0) continue;  // ParaView cannot show an empty grid
-    const std::string base = h5_name + ":/records/" + record_name(k) + "/";
-    auto item = [&](const std::string& dims, const char* type, const char* bytes,
-                    const std::string& dataset) {
-      x << "     <DataItem Dimensions=\"" << dims << "\" NumberType=\"" << type << "\" Precision=\""
-        << bytes << "\" Format=\"HDF\">" << base << dataset << "</DataItem>\n";
-    };
-    const std::string vector = std::to_string(n) + " 3";
-    const std::string scalar = std::to_string(n);
-    auto attribute = [&](const char* name, const char* kind, const std::string& dims,
-                         const char* type, const char* bytes, const std::string& dataset) {
-      x << "    <Attribute Name=\"" << name << "\" AttributeType=\"" << kind
-        << "\" Center=\"Node\">\n";
-      item(dims, type, bytes, dataset);
-      x << "    </Attribute>\n";
-    };
-    x << "   <Grid Name=\"record " << record_name(k) << "\" GridType=\"Uniform\">\n"
-      << "    <Time Value=\"" << o.times[k] << "\"/>\n"
-      << "    <Topology TopologyType=\"Polyvertex\" NumberOfElements=\"" << n
-      << "\" NodesPerElement=\"1\"/>\n"
-      << "    <Geometry GeometryType=\"XYZ\">\n";
-    item(vector, "Float", precision, "I_r_S");
-    x << "    </Geometry>\n";
-    attribute("radius", "Scalar", scalar, "Float", precision, "radius");
-    attribute("velocity", "Vector", vector, "Float", precision, "I_v_S");
-    attribute("angular_velocity_K", "Vector", vector, "Float", precision, "K_omega");
-    attribute("id", "Scalar", scalar, "UInt", "8", "id");
-    x << "   </Grid>\n";
+    if (o.counts[k] == 0) continue;  // ParaView cannot show an empty grid
+    write_xdmf_grid(x, h5_name, o.float32, k, o.times[k], o.counts[k]);
   }
-  x << "  </Grid>\n"
-    << " </Domain>\n"
-    << "</Xdmf>\n";
-  write_file_atomically(xdmf_path(o.path), x.str());
+  x << kXdmfFooter;
+  const std::string text = x.str();
+  const std::filesystem::path path = xdmf_path(o.path);
+  o.xdmf.close();
+  write_file_atomically(path, text);
+  // Kept open to append the records that follow in place, over the footer.
+  o.xdmf.open(path, std::ios::binary | std::ios::in | std::ios::out);
+  if (!o.xdmf) throw IoError(path.string() + ": cannot open the XDMF file to append to it");
+  o.xdmf_footer = static_cast<std::streamoff>(text.size() - kXdmfFooter.size());
+}
+
+void OutputFile::append_xdmf() {
+  Impl& o = *impl_;
+  const std::size_t k = o.times.size() - 1;
+  if (o.counts[k] == 0) return;  // ParaView cannot show an empty grid
+  std::ostringstream x;
+  x.precision(17);
+  write_xdmf_grid(x, o.path.filename().string(), o.float32, k, o.times[k], o.counts[k]);
+  x << kXdmfFooter;
+  const std::string text = x.str();
+  o.xdmf.seekp(o.xdmf_footer);
+  o.xdmf.write(text.data(), static_cast<std::streamsize>(text.size()));
+  o.xdmf.flush();
+  if (!o.xdmf) throw IoError(xdmf_path(o.path).string() + ": cannot append to the XDMF file");
+  o.xdmf_footer += static_cast<std::streamoff>(text.size() - kXdmfFooter.size());
 }
 
 OutputSummary read_summary(const std::filesystem::path& path) {

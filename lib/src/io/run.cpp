@@ -3,7 +3,9 @@
 #include "grbd/io/run.hpp"
 
 #include <chrono>
+#include <algorithm>
 #include <memory>
+#include <string_view>
 
 namespace grbd::io {
 
@@ -13,7 +15,32 @@ double seconds_since(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
+std::string_view line_of(std::string_view text, std::size_t begin) {
+  const std::size_t end = text.find('\n', begin);
+  return text.substr(begin, end == std::string_view::npos ? std::string_view::npos : end - begin);
+}
+
 }  // namespace
+
+std::string scene_difference(const std::string& saved, const std::string& given,
+                             const std::filesystem::path& scene_file) {
+  if (saved == given) return {};
+  std::size_t line = 1, begin = 0;  // the line of the first differing character, and its start
+  const std::size_t n = std::min(saved.size(), given.size());
+  for (std::size_t i = 0; i < n && saved[i] == given[i]; ++i) {
+    if (saved[i] == '\n') {
+      ++line;
+      begin = i + 1;
+    }
+  }
+  const auto quoted = [&](const std::string& text) {
+    return begin >= text.size() ? std::string("the end of the file")
+                                : '"' + std::string(line_of(text, begin)) + '"';
+  };
+  return scene_file.string() + ":" + std::to_string(line) + ": the scene differs from the one the " +
+         "checkpoint was written with: it has " + quoted(given) + ", the checkpoint's has " +
+         quoted(saved) + "; the run continues with the scene given";
+}
 
 RunResult run(const scene::Scene& scene, const RunOptions& options) {
   const auto start = std::chrono::steady_clock::now();
@@ -22,6 +49,10 @@ RunResult run(const scene::Scene& scene, const RunOptions& options) {
   std::unique_ptr<OutputFile> output;
   if (options.restart) {
     const Checkpoint checkpoint = read_checkpoint(*options.restart);
+    if (const std::string difference = scene_difference(checkpoint.scene_text, scene.text, scene.file);
+        !difference.empty() && options.on_warning) {
+      options.on_warning(difference);
+    }
     simulation = std::make_unique<scene::Simulation>(scene, checkpoint.state);
     std::error_code error;
     if (std::filesystem::exists(options.output, error)) {

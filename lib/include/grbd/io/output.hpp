@@ -80,7 +80,10 @@ class OutputFile {
   struct Impl;
   void write_bodies(scene::Simulation& simulation);
   void write_steps();
-  void write_xdmf() const;
+  // The XDMF is written whole (atomically) when the file is created or reopened, and each record
+  // is appended in place over its closing tags: O(1) per record, not O(records).
+  void write_xdmf();
+  void append_xdmf();
   // Deletes the HDF5 handles of Impl under grbd's HDF5 lock.
   struct Release {
     void operator()(Impl* impl) const;

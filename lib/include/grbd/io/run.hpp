@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <functional>
 #include <optional>
+#include <string>
 
 #include "grbd/io/checkpoint.hpp"
 #include "grbd/io/output.hpp"
@@ -26,7 +27,15 @@ struct RunOptions {
   const volatile std::sig_atomic_t* stop = nullptr;
   /// Called after every step (progress display).
   std::function<void(const scene::Simulation&, const timestep::StepReport&)> on_step;
+  /// Called with a warning the run goes on after: a restart whose scene text differs from the
+  /// checkpoint's (the first line that differs). Without it, warnings are not reported.
+  std::function<void(const std::string&)> on_warning;
 };
+
+/// Where two scene texts first differ: "" when they are equal, else a message naming the line of
+/// `scene_file` and the two versions of it (`given` is the file's text, `saved` the other).
+std::string scene_difference(const std::string& saved, const std::string& given,
+                             const std::filesystem::path& scene_file);
 
 /// What a run did.
 struct RunResult {
