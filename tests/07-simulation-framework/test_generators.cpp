@@ -1,6 +1,6 @@
 // Chapter 7: the generators. Lattice, packing and inflow place bodies without overlaps inside
-// their regions, reproducibly from their seeds; the inflow keeps its rate; the outlet removes
-// what leaves the domain.
+// their regions, reproducibly from their seeds, and never inside static geometry; the inflow
+// keeps its rate; the outlet removes what leaves the domain.
 
 #include <gtest/gtest.h>
 
@@ -193,6 +193,118 @@ rate = 1000
   EXPECT_GT(sim.bodies_created(), 1U);
   const Placement p = check(sim, Vector3(-1, -1, -1), Vector3(1, 1, 1));
   EXPECT_GE(p.min_gap, 0.0);
+}
+
+// What a generator refuses to start with: a body inside static geometry or inside another body.
+std::string refusal(const std::string& text, const std::string& file) {
+  try {
+    const Scene scene = parse_scene(text, file);
+    Simulation sim(scene);
+  } catch (const SceneError& e) {
+    return e.what();
+  }
+  return "no error";
+}
+
+// A table top: the box 0 ≤ x, y ≤ 0.1, 0.02 ≤ z ≤ 0.04.
+const std::string kTable = R"(
+[[static]]
+name = "table"
+shape = "box"
+half_extents = [0.05, 0.05, 0.01]
+position = [0.05, 0.05, 0.03]
+material = "glass"
+)";
+
+// The gap between a sphere (c, r) and the table, by the closest point of the box (clamping).
+double table_gap(const Vector3& c, double r) {
+  const Vector3 lo(0.0, 0.0, 0.02), hi(0.1, 0.1, 0.04);
+  const Vector3 closest = c.cwiseMax(lo).cwiseMin(hi);
+  return (c - closest).norm() - r;  // > 0 only outside; a centre inside gives −r or less
+}
+
+TEST(Generators, LatticesAndListsNeverStartInsideStaticGeometryOrOtherBodies) {
+  // Lattice sites 0.01 apart from z = 0.005: the layer z = 0.015 touches the table's underside
+  // (allowed), the layer z = 0.025 has its centres inside the table, 0.005 from its faces x = 0
+  // and z = 0.02: pushed out by 0.005 + r = 0.01.
+  const std::string lattice = R"(radius = 0.005
+[bodies.generator]
+kind = "lattice"
+region = { min = [0, 0, 0], max = [0.1, 0.1, 0.1] }
+)";
+  EXPECT_NE(refusal(scene_text(lattice, kTable), "table.toml")
+                .find("table.toml: bodies[0] (bodies[0]): generator: the body at (0.005, 0.005, "
+                      "0.025) m overlaps static[0] (table) by 0.01 m"),
+            std::string::npos)
+      << refusal(scene_text(lattice, kTable), "table.toml");
+  // Two layers below the table are fine: they touch it.
+  const std::string below = replace_all(lattice, "max = [0.1, 0.1, 0.1]", "max = [0.1, 0.1, 0.02]");
+  EXPECT_EQ(refusal(scene_text(below, kTable), "below.toml"), "no error");
+  // A second lattice (spacing 0.008) in the same region as the first: its first body, at
+  // (0.004, 0.004, 0.004), overlaps the first one's.
+  const std::string twice = below + R"(
+[[bodies]]
+name = "again"
+density = 2500
+material = "glass"
+radius = 0.004
+[bodies.generator]
+kind = "lattice"
+region = { min = [0, 0, 0], max = [0.1, 0.1, 0.02] }
+)";
+  EXPECT_NE(refusal(scene_text(twice), "twice.toml")
+                .find("twice.toml: bodies[1] (again): generator: the body at (0.004, 0.004, "
+                      "0.004) m overlaps the body with id 0, made before it"),
+            std::string::npos)
+      << refusal(scene_text(twice), "twice.toml");
+  // A list whose second position is 0.009 from its first, with radii 0.005.
+  const std::string list = R"(radius = 0.005
+positions = [[0.5, 0.5, 0.5], [0.509, 0.5, 0.5]]
+)";
+  EXPECT_NE(refusal(scene_text(list), "list.toml")
+                .find("list.toml: bodies[0] (bodies[0]): generator: the body at (0.509, 0.5, 0.5) "
+                      "m overlaps the body with id 0"),
+            std::string::npos)
+      << refusal(scene_text(list), "list.toml");
+}
+
+TEST(Generators, PackingAndInflowPlaceNothingInsideStaticGeometry) {
+  // Random packing in a region the table cuts through: every sphere clear of the box.
+  const Scene packing = parse_scene(scene_text(R"(radius = 0.004
+[bodies.generator]
+kind = "packing"
+region = { min = [0, 0, 0], max = [0.1, 0.1, 0.1] }
+count = 300
+seed = 11
+)",
+                                               kTable),
+                                    "packing.toml");
+  Simulation sim(packing);
+  ASSERT_EQ(sim.system().size(), 300U);
+  double gap = INFINITY;
+  for (const auto& x : sim.system().states()) gap = std::min(gap, table_gap(x.q.head<3>(), 0.004));
+  EXPECT_GE(gap, 0.0);
+  // An inflow whose region reaches 0.01 below a floor at z = 0.01: every body above the floor.
+  const Scene inflow = parse_scene(scene_text(R"(radius = 0.002
+[bodies.generator]
+kind = "inflow"
+region = { min = [0, 0, 0], max = [0.1, 0.1, 0.02] }
+rate = 2000
+count = 60
+)",
+                                              R"(
+[[static]]
+name = "floor"
+shape = "half_space"
+normal = [0, 0, 1]
+point = [0, 0, 0.01]
+material = "glass"
+)"),
+                                   "inflow.toml");
+  Simulation flow(inflow);
+  for (int k = 0; k < 30; ++k) flow.step();
+  ASSERT_EQ(flow.system().size(), 60U);
+  for (const auto& x : flow.system().states()) EXPECT_GE(x.q[2] - 0.01, 0.002 - 1e-12);
 }
 
 TEST(Generators, TheOutletRemovesWhatLeavesTheDomain) {

@@ -4,11 +4,15 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
+#include <memory>
 #include <sstream>
 #include <unordered_map>
 
 #include "grbd/body/mass_properties.hpp"
+#include "grbd/collision/narrow_phase.hpp"
 #include "grbd/collision/world.hpp"
+#include "grbd/kinematics/rigid_motion.hpp"
 #include "grbd/kinematics/rotation.hpp"
 
 namespace grbd::scene {
@@ -62,14 +66,16 @@ Vector7 random_orientation(Random& random, const Vector3& position) {
 // so that an overlap is always with a sphere of a neighbouring cell.
 class OverlapGrid {
  public:
-  explicit OverlapGrid(double h) : h_(h) {}
+  explicit OverlapGrid(double h = 1.0) : h_(h) {}
   void insert(const Vector3& c, double r) {
     const auto index = static_cast<std::uint32_t>(centres_.size());
     centres_.push_back(c);
     radii_.push_back(r);
     cells_[key(cell(c))].push_back(index);
   }
-  bool overlaps(const Vector3& c, double r) const {
+  // The index (in the order of insertion) of a sphere that the sphere (c, r) overlaps by more
+  // than `slack` [m], or −1.
+  std::int64_t find(const Vector3& c, double r, double slack = 0.0) const {
     const Eigen::Array3i k = cell(c);
     for (int dz = -1; dz <= 1; ++dz) {
       for (int dy = -1; dy <= 1; ++dy) {
@@ -77,13 +83,21 @@ class OverlapGrid {
           const auto it = cells_.find(key(k + Eigen::Array3i(dx, dy, dz)));
           if (it == cells_.end()) continue;
           for (const std::uint32_t j : it->second) {
-            const double reach = r + radii_[j];
-            if ((centres_[j] - c).squaredNorm() < reach * reach) return true;
+            const double reach = r + radii_[j] - slack;
+            if ((centres_[j] - c).squaredNorm() < reach * reach) return j;
           }
         }
       }
     }
-    return false;
+    return -1;
+  }
+  bool overlaps(const Vector3& c, double r) const { return find(c, r) >= 0; }
+  // Empties the grid for a new cell size, keeping its memory.
+  void reset(double h) {
+    h_ = h;
+    centres_.clear();
+    radii_.clear();
+    for (auto& [k, cell] : cells_) cell.clear();
   }
 
  private:
@@ -131,12 +145,51 @@ double largest_bounding_radius(const BodyGroup& group) {
   return bounding_radius(largest);
 }
 
+// Buffers of the generators, kept between steps so that an inflow allocates nothing once warm.
+struct Simulation::Scratch {
+  OverlapGrid grid;
+  std::vector<timestep::GlobalId> owner;  // the id of each sphere in grid
+  std::vector<std::size_t> near;          // the bodies near an inflow region
+  std::vector<collision::ContactGeometry> contacts;
+  Scratch() = default;
+};
+
+Simulation::~Simulation() = default;
+
+std::pair<double, std::size_t> Simulation::static_gap(const BodyConstants& c,
+                                                      const body::State& x) {
+  const collision::Shape shape = shape_of(c);
+  const collision::Placement pose{kinematics::position(x.q),
+                                  kinematics::rotation_matrix(kinematics::orientation(x.q))};
+  double gap = std::numeric_limits<double>::infinity();
+  std::size_t which = 0;
+  const auto objects = statics_.objects();
+  for (std::size_t s = 0; s < objects.size(); ++s) {
+    std::vector<collision::ContactGeometry>& found = scratch_->contacts;
+    found.clear();
+    // The kernels take the shapes in the kind order sphere, box, capsule, half-space, mesh.
+    if (collision::kind(shape) <= collision::kind(objects[s].shape)) {
+      collision::collide(shape, pose, objects[s].shape, objects[s].pose, 0.0, found);
+    } else {
+      collision::collide(objects[s].shape, objects[s].pose, shape, pose, 0.0, found);
+    }
+    for (const collision::ContactGeometry& geometry : found) {
+      if (geometry.g_N < gap) {
+        gap = geometry.g_N;
+        which = s;
+      }
+    }
+  }
+  return {gap, which};
+}
+
 Simulation::Simulation(const Scene& scene) : Simulation(scene, nullptr) {}
 
 Simulation::Simulation(const Scene& scene, const SimulationState& state)
     : Simulation(scene, &state) {}
 
-Simulation::Simulation(const Scene& scene, const SimulationState* state) : scene_(scene) {
+Simulation::Simulation(const Scene& scene, const SimulationState* state)
+    : scene_(scene), scratch_(std::make_unique<Scratch>()) {
   for (const std::string& name : scene.materials) materials_.add(name);
   if (scene.default_contact) materials_.set_default(*scene.default_contact);
   for (const ContactSpec& c : scene.contacts) {
@@ -279,10 +332,56 @@ void Simulation::generate_initial() {
     const double r_b = largest_bounding_radius(group);
     auto state_at = [&](const Vector3& position) { return initial_state(group, random, position); };
     std::uint64_t made = 0;
+    // List and lattice bodies go where they are told: each is checked against the static
+    // geometry and, for spheres, against the spheres made before it (earlier groups, earlier
+    // positions of a list), so that a scene never starts with bodies inside each other.
+    const bool spheres = group.shape == ShapeKind::sphere;
+    if (spheres && spec.kind != GeneratorKind::packing) {
+      double r_existing = 0.0;
+      for (std::size_t i = 0; i < system_.size(); ++i) {
+        if (collision::kind(system_.shapes()[i]) == ShapeKind::sphere) {
+          r_existing = std::max(r_existing, system_.bounding_radii()[i]);
+        }
+      }
+      scratch_->grid.reset(r_b + std::max(r_b, r_existing));
+      scratch_->owner.clear();
+      for (std::size_t i = 0; i < system_.size(); ++i) {
+        if (collision::kind(system_.shapes()[i]) != ShapeKind::sphere) continue;
+        scratch_->grid.insert(system_.states()[i].q.head<3>(), system_.bounding_radii()[i]);
+        scratch_->owner.push_back(system_.ids()[i]);
+      }
+    }
+    auto place = [&](const BodyConstants& c, const body::State& x) {
+      const Vector3 p = x.q.head<3>();
+      const double r = bounding_radius(c);
+      if (spheres) {
+        const std::int64_t j = scratch_->grid.find(p, r, 1e-6 * r);
+        if (j >= 0) {
+          std::ostringstream out;
+          out << "generator: the body at (" << p.x() << ", " << p.y() << ", " << p.z()
+              << ") m overlaps the body with id " << scratch_->owner[static_cast<std::size_t>(j)]
+              << ", made before it; move the region or positions apart";
+          fail(scene_, g, out.str());
+        }
+        scratch_->grid.insert(p, r);
+        scratch_->owner.push_back(c.id);
+      }
+      if (!c.fixed) {
+        const auto [gap, s] = static_gap(c, x);
+        if (gap < -1e-6 * r) {
+          std::ostringstream out;
+          out << "generator: the body at (" << p.x() << ", " << p.y() << ", " << p.z()
+              << ") m overlaps static[" << s << "] (" << scene_.statics[s].name << ") by " << -gap
+              << " m; move the region or positions clear of the static geometry";
+          fail(scene_, g, out.str());
+        }
+      }
+      add_body(c, x);
+    };
     if (spec.kind == GeneratorKind::list) {
       for (const Vector3& p : spec.positions) {
         const BodyConstants c = make_constants(g, random);
-        add_body(c, state_at(p));
+        place(c, state_at(p));
         ++next_id_;
         ++made;
       }
@@ -322,7 +421,7 @@ void Simulation::generate_initial() {
         const double amplitude = spec.jitter * (0.5 * s - r_i);
         Vector3 p = spec.region.min + (site.array() + 0.5).matrix() * s;
         for (int d = 0; d < 3; ++d) p[d] += amplitude * (2.0 * random.uniform() - 1.0);
-        add_body(c, state_at(p));
+        place(c, state_at(p));
         ++next_id_;
         ++made;
       }
@@ -375,11 +474,12 @@ void Simulation::generate_initial() {
         for (int attempt = 0; attempt < spec.max_attempts && !placed; ++attempt) {
           Vector3 p;
           for (int d = 0; d < 3; ++d) p[d] = spec.region.min[d] + r + room[d] * random.uniform();
-          if (!grid.overlaps(p, r)) {
-            grid.insert(p, r);
-            states[k] = state_at(p);
-            placed = true;
-          }
+          if (grid.overlaps(p, r)) continue;
+          const body::State x = state_at(p);
+          if (!c.fixed && static_gap(c, x).first < 0.0) continue;  // inside static geometry
+          grid.insert(p, r);
+          states[k] = x;
+          placed = true;
         }
         if (!placed) {
           std::ostringstream out;
@@ -419,7 +519,10 @@ void Simulation::inflow() {
     double r_existing = 0.0;
     const Vector3 lo = spec.region.min;
     const Vector3 hi = spec.region.max;
-    std::vector<std::size_t> near;
+    // The bodies that reach into the region: one pass over the system, O(N) like the step
+    // itself, into buffers kept between steps.
+    std::vector<std::size_t>& near = scratch_->near;
+    near.clear();
     for (std::size_t i = 0; i < system_.size(); ++i) {
       const double r = system_.bounding_radii()[i];
       const Vector3 c = system_.states()[i].q.head<3>();
@@ -429,7 +532,8 @@ void Simulation::inflow() {
         r_existing = std::max(r_existing, r);
       }
     }
-    OverlapGrid grid(r_b + std::max(r_b, r_existing));
+    OverlapGrid& grid = scratch_->grid;
+    grid.reset(r_b + std::max(r_b, r_existing));
     for (std::size_t i : near)
       grid.insert(system_.states()[i].q.head<3>(), system_.bounding_radii()[i]);
     while (state.created < due) {
@@ -446,15 +550,17 @@ void Simulation::inflow() {
       }
       bool placed = false;
       Vector3 p;
+      body::State x;
       for (int attempt = 0; attempt < spec.max_attempts && !placed; ++attempt) {
         for (int d = 0; d < 3; ++d) p[d] = lo[d] + r + room[d] * trial.uniform();
-        placed = !grid.overlaps(p, r);
+        if (grid.overlaps(p, r)) continue;
+        x = initial_state(group, trial, p);
+        placed = c.fixed || statics_.size() == 0 || static_gap(c, x).first >= 0.0;
       }
       if (!placed) {
         backlog_ += due - state.created;
         break;
       }
-      const body::State x = initial_state(group, trial, p);
       grid.insert(p, r);
       add_body(c, x);
       ++next_id_;

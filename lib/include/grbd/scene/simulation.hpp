@@ -5,8 +5,10 @@
 /// must keep to continue a run bit for bit.
 
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <span>
+#include <utility>
 #include <vector>
 
 #include "grbd/scene/scene.hpp"
@@ -62,6 +64,7 @@ class Simulation {
   /// Builds the scene and continues from `state` instead (restart); throws SceneError when the
   /// state does not fit the scene (a material or group it does not have).
   Simulation(const Scene& scene, const SimulationState& state);
+  ~Simulation();
   Simulation(const Simulation&) = delete;
   Simulation& operator=(const Simulation&) = delete;
 
@@ -105,6 +108,10 @@ class Simulation {
   void outlet();
   void check_shapes() const;
   BodyConstants make_constants(std::size_t group, Random& random);
+  // The deepest overlap of a body (its constants and a state) with the static geometry: the gap
+  // (< 0 when they overlap, +∞ without static objects) and the static object's index.
+  std::pair<double, std::size_t> static_gap(const BodyConstants& c, const body::State& x);
+  struct Scratch;
 
   const Scene& scene_;
   timestep::MaterialTable materials_;
@@ -118,6 +125,7 @@ class Simulation {
   double removed_mass_ = 0.0;
   std::uint64_t backlog_ = 0;
   std::vector<std::size_t> leaving_;
+  std::unique_ptr<Scratch> scratch_;
 };
 
 /// The radius of the sphere about S that holds a body of a group, at its largest [m].
