@@ -7,8 +7,12 @@ numbers of the source (so Doxygen's warnings still point at the right line):
 
 - Exercise headings `### Exercise N.M {#label}` get their title from the exercise's marker in
   solutions/ (`// BEGIN EXERCISE N.M: title`), the single source of every exercise title.
-- Figures `\\image html NAME.svg "caption"` are numbered per chapter ("Figure N.k: caption") and
+- Figures `\\image html NAME.svg "caption"` (or NAME.png) are numbered per chapter ("Figure N.k: caption") and
   get the anchor `fig_NAME`; `\\figref{NAME}` in the text becomes a link "Figure N.k".
+- Optional parts `\\if NAME` ... [`\\else` ...] `\\endif` (lines of their own, outside code
+  blocks) are resolved here, against the sections given by `--sections=NAME,...` (Doxygen's
+  ENABLED_SECTIONS, which the build sets from the tools it found): the lines of the branch not
+  taken, and the directives, become empty lines, so figures are numbered as the reader sees them.
 - Every chapter gets previous/next links, at the top (in place of the blank line after the title)
   and at the bottom, following the order of the chapter folders; the last chapter leads to the
   bibliography.
@@ -30,8 +34,10 @@ import grbd_exercises as gx  # noqa: E402
 
 EXERCISE = re.compile(r"^(?P<hashes>#{2,4})\s+Exercise\s+(?P<id>\d+\.\d+)(?P<rest>[^{]*?)\s*"
                       r"(?P<anchor>\{#\w+\})\s*$")
-IMAGE = re.compile(r'^(?P<indent>\s*)\\image\s+html\s+(?P<file>(?P<name>[\w.-]+)\.svg)\s+'
+IMAGE = re.compile(r'^(?P<indent>\s*)\\image\s+html\s+(?P<file>(?P<name>[\w.-]+)\.(?:svg|png))\s+'
                    r'"(?P<caption>[^"]*)"(?P<rest>.*)$')
+CONDITION = re.compile(r"^\s*\\(?P<directive>if|else|endif)\b\s*(?P<name>\w*)\s*$")
+FENCE = re.compile(r"^\s*(```|~~~)")
 FIGREF = re.compile(r"\\figref\{(?P<name>[\w.-]+)\}")
 
 
@@ -79,11 +85,42 @@ def book_error(message: str, path: pathlib.Path, line: int) -> str:
     return f"BOOK ERROR: {message}"
 
 
-def filter_chapter(path: pathlib.Path, text: str) -> str:
+def resolve_sections(lines: list[str], sections: set[str], path: pathlib.Path) -> list[str]:
+    """The lines with every `\\if NAME` block resolved: kept where NAME is in `sections`, else its
+    `\\else` branch; dropped lines and the directives become empty lines (same line numbers)."""
+    out: list[str] = []
+    stack: list[tuple[bool, bool]] = []  # (this branch shown, the enclosing block shown)
+    fenced = False
+    for i, line in enumerate(lines):
+        shown = all(branch for branch, _ in stack)
+        if FENCE.match(line):
+            fenced = not fenced
+        condition = None if fenced else CONDITION.match(line)
+        if condition is None:
+            out.append(line if shown else "")
+            continue
+        directive, name = condition.group("directive"), condition.group("name")
+        if directive == "if" and name:
+            stack.append((name in sections, shown))
+        elif directive == "else" and stack and not name:
+            branch, outer = stack.pop()
+            stack.append((not branch, outer))
+        elif directive == "endif" and stack and not name:
+            stack.pop()
+        else:
+            out.append(book_error(f"unmatched or malformed '{line.strip()}'", path, i + 1))
+            continue
+        out.append("")
+    if stack:
+        out.append(book_error("an \\if block is not closed by \\endif", path, len(lines)))
+    return out
+
+
+def filter_chapter(path: pathlib.Path, text: str, sections: set[str] | None = None) -> str:
     m = chapter_heading(text)
     if not m:
         return text  # not a chapter page: leave it alone
-    lines = text.split("\n")
+    lines = resolve_sections(text.split("\n"), sections or set(), path)
     number, label = int(m.group("number")), m.group("label")
     pages = chapter_pages()
     labels = [page_label for page_label, _ in pages]
@@ -139,12 +176,17 @@ def filter_chapter(path: pathlib.Path, text: str) -> str:
 
 
 def main() -> int:
-    if len(sys.argv) != 2:
-        print("usage: book_filter.py <page.md>  (a Doxygen INPUT_FILTER)", file=sys.stderr)
+    args = sys.argv[1:]
+    sections: set[str] = set()
+    if args and args[0].startswith("--sections="):
+        sections = {name for name in args.pop(0)[len("--sections="):].split(",") if name}
+    if len(args) != 1:
+        print("usage: book_filter.py [--sections=NAME,...] <page.md>  (a Doxygen INPUT_FILTER)",
+              file=sys.stderr)
         return 2
-    path = pathlib.Path(sys.argv[1])
+    path = pathlib.Path(args[0])
     text = path.read_text(encoding="utf-8")
-    sys.stdout.write(filter_chapter(path, text))
+    sys.stdout.write(filter_chapter(path, text, sections))
     return 0
 
 

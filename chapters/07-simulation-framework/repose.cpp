@@ -1,9 +1,9 @@
 // Chapter 7 demo: the angle of repose. Pours the heap of repose.toml (beads poured onto a table of
 // fixed beads between two frictionless walls) once per friction coefficient μ between the beads,
-// goes on after the pour until every bead is at rest, then measures the heap's surface: in bins
-// one diameter wide along the table, the highest centre of a bead; a straight line fitted by
-// least squares to that height against |x| on both flanks (clear of the pouring point and of the
-// table's ends) gives the angle θ = atan(−slope).
+// goes on after the pour until every bead is at rest, then measures the heap's surface
+// (grbd::scene::heap_surface: in bins one diameter wide along the table, the highest centre of a
+// bead) and fits a straight line to both flanks, clear of the pouring point and of the table's
+// ends (grbd::scene::fit_flanks): θ = atan(−slope).
 //
 // Usage: ch07_repose <data directory> <scene.toml> [t_max mu...]
 // Writes profile.csv (the surface per μ), relax.csv (the angle while the heap comes to rest),
@@ -11,15 +11,14 @@
 
 #include <algorithm>
 #include <chrono>
-#include <cmath>
 #include <filesystem>
 #include <iomanip>
 #include <iostream>
-#include <numbers>
 #include <sstream>
 #include <string>
 #include <vector>
 
+#include "grbd/scene/measure.hpp"
 #include "grbd/scene/scene.hpp"
 #include "grbd/scene/simulation.hpp"
 #include "grbd_demo/demo.hpp"
@@ -27,72 +26,6 @@
 namespace {
 
 constexpr const char* kProgram = "ch07_repose";
-constexpr double kDegree = 180.0 / std::numbers::pi;
-
-struct Surface {
-  std::vector<double> x, top;  // bin centres and the highest centre in each [m]
-  double angle = 0.0;          // [degrees]
-  double rms = 0.0;            // of the straight line [m]
-};
-
-// [repose measure]
-// The heap's surface: the highest centre of a dynamic bead in each bin of width w along x over
-// [−L, L]; then the least-squares line z = a + b |x| over the bins with x_min ≤ |x| ≤ x_max,
-// and θ = atan(−b).
-Surface measure(const grbd::scene::Simulation& sim, double L, double w, double x_min,
-                double x_max) {
-  Surface s;
-  const auto bins = static_cast<std::size_t>(std::round(2.0 * L / w));
-  s.top.assign(bins, 0.0);
-  s.x.resize(bins);
-  const auto states = sim.system().states();
-  for (std::size_t i = 0; i < states.size(); ++i) {
-    if (!sim.system().dynamic(i)) continue;  // the table's beads
-    const double k = std::floor((states[i].q[0] + L) / w);
-    if (k < 0.0 || k >= static_cast<double>(bins)) continue;
-    double& top = s.top[static_cast<std::size_t>(k)];
-    top = std::max(top, states[i].q[2]);
-  }
-  double n = 0.0, sx = 0.0, sz = 0.0, sxx = 0.0, sxz = 0.0;
-  const auto in_fit = [&](std::size_t k) {
-    const double r = std::abs(s.x[k]);
-    return r >= x_min && r <= x_max && s.top[k] > 0.0;
-  };
-  for (std::size_t k = 0; k < bins; ++k) {
-    s.x[k] = -L + (static_cast<double>(k) + 0.5) * w;
-    if (!in_fit(k)) continue;
-    const double r = std::abs(s.x[k]);
-    n += 1.0;
-    sx += r;
-    sz += s.top[k];
-    sxx += r * r;
-    sxz += r * s.top[k];
-  }
-  if (n < 3.0) return s;  // no heap yet: angle 0
-  const double b = (n * sxz - sx * sz) / (n * sxx - sx * sx);
-  const double a = (sz - b * sx) / n;
-  double sq = 0.0;
-  for (std::size_t k = 0; k < bins; ++k) {
-    if (in_fit(k)) sq += std::pow(s.top[k] - a - b * std::abs(s.x[k]), 2);
-  }
-  s.rms = std::sqrt(sq / n);
-  s.angle = std::atan(-b) * kDegree;
-  return s;
-}
-// [repose measure]
-
-// [repose rest]
-// At rest: every dynamic body slower than `speed` [m/s]. With ε_N = 0 and a converged solver a
-// heap at rest has velocities of round-off size, so the threshold only has to be well below the
-// velocity g Δt that one step of gravity gives (3.9 mm/s here).
-bool at_rest(const grbd::scene::Simulation& sim, double speed) {
-  const auto states = sim.system().states();
-  for (std::size_t i = 0; i < states.size(); ++i) {
-    if (sim.system().dynamic(i) && states[i].u.head<3>().norm() >= speed) return false;
-  }
-  return true;
-}
-// [repose rest]
 
 // The half length of the table: the static box named "table".
 double table_half_length(const grbd::scene::Scene& scene) {
@@ -117,10 +50,12 @@ double pour_end(const grbd::scene::Scene& scene) {
 
 struct Heap {
   double mu = 0.0;
-  Surface surface;
+  grbd::scene::HeapSurface surface;
+  grbd::scene::FlankFit fit;
   double rest = -1.0;  // the time every bead was at rest [s]; −1: not by t_max
   std::size_t beads = 0;
   std::uint64_t fell = 0;
+  double max_speed = 0.0;  // of a bead when the run stopped [m/s]
   double seconds = 0.0;
 };
 
@@ -151,8 +86,10 @@ int main(int argc, char** argv) {
     const double poured = pour_end(base);
     const auto steps_per_check = static_cast<std::uint64_t>(std::round(0.01 / base.settings.dt));
     const auto steps_per_trace = static_cast<std::uint64_t>(std::round(0.1 / base.settings.dt));
-    const auto surface = [&](const grbd::scene::Simulation& sim) {
-      return measure(sim, L, d, 3.0 * d, L - 2.0 * d);
+    // The flanks: clear of the pouring point (3 d) and of the table's ends (2 d).
+    const auto measure = [&](const grbd::scene::Simulation& sim, Heap& heap) {
+      heap.surface = grbd::scene::heap_surface(sim.system(), L, d);
+      heap.fit = grbd::scene::fit_flanks(heap.surface, 3.0 * d, L - 2.0 * d);
     };
     std::vector<Heap> heaps;
     grbd::demo::OutputFile relax(dir / "relax.csv", "# t_s angle_deg (one block per mu)");
@@ -166,23 +103,36 @@ int main(int argc, char** argv) {
       Heap heap;
       heap.mu = mu;
       relax << "\n\n# mu = " << mu << '\n';
+      // [repose run]
       while (!sim.finished()) {
         const auto report = sim.step();
         sim.created().clear();  // no output
-        if (report.step % steps_per_trace == 0) relax << report.t << ' ' << surface(sim).angle << '\n';
-        if (report.t > poured && report.step % steps_per_check == 0 && at_rest(sim, 1e-3)) {
+        if (report.step % steps_per_trace == 0 && report.t > 0.5) {
+          measure(sim, heap);
+          relax << report.t << ' ' << heap.fit.angle << '\n';
+        }
+        // At rest: every bead slower than 1 mm/s, a quarter of what one step of gravity gives.
+        if (report.t > poured && report.step % steps_per_check == 0 &&
+            grbd::scene::at_rest(sim.system(), 1e-3)) {
           heap.rest = report.t;
           break;
         }
       }
+      // [repose run]
       heap.seconds =
           std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-      heap.surface = surface(sim);
+      measure(sim, heap);
       heap.fell = sim.bodies_removed();
-      for (std::size_t i = 0; i < sim.system().size(); ++i) heap.beads += sim.system().dynamic(i);
-      std::cout << kProgram << ": mu = " << mu << ": angle " << heap.surface.angle
-                << " degrees (rms " << heap.surface.rms * 1e3 << " mm), " << heap.beads
-                << " beads on the table, " << heap.fell << " fell off, "
+      const auto states = sim.system().states();
+      for (std::size_t i = 0; i < states.size(); ++i) {
+        if (!sim.system().dynamic(i)) continue;
+        ++heap.beads;
+        heap.max_speed = std::max(heap.max_speed, states[i].u.head<3>().norm());
+      }
+      std::cout << kProgram << ": mu = " << mu << ": angle " << heap.fit.angle << " ± "
+                << heap.fit.angle_error << " degrees (rms " << heap.fit.rms * 1e3 << " mm), "
+                << heap.beads << " beads on the table, " << heap.fell << " fell off, fastest "
+                << heap.max_speed << " m/s, "
                 << (heap.rest < 0.0 ? std::string("still moving at t_max")
                                     : "at rest at t = " + std::to_string(heap.rest) + " s")
                 << ", " << heap.seconds << " s" << std::endl;
@@ -200,17 +150,19 @@ int main(int argc, char** argv) {
     }
     profile.finish();
     grbd::demo::OutputFile table(dir / "repose.csv");
-    table << "# mu angle_deg rms_m rest_s beads atan_mu_deg\n";
+    table << "# mu angle_deg angle_error_deg rms_m rest_s beads a_m b x_min_m x_max_m "
+             "max_speed_m_s\n";
     for (const auto& h : heaps) {
-      table << h.mu << ' ' << h.surface.angle << ' ' << h.surface.rms << ' ' << h.rest << ' '
-            << h.beads << ' ' << std::atan(h.mu) * kDegree << '\n';
+      table << h.mu << ' ' << h.fit.angle << ' ' << h.fit.angle_error << ' ' << h.fit.rms << ' '
+            << h.rest << ' ' << h.beads << ' ' << h.fit.a << ' ' << h.fit.b << ' ' << 3.0 * d << ' '
+            << L - 2.0 * d << ' ' << h.max_speed << '\n';
     }
     table.finish();
     std::ostringstream text;
     text << std::setprecision(3) << kProgram << ": table 2 x " << L * 1e3 << " mm, d = " << d * 1e3
          << " mm;";
     for (const auto& h : heaps) {
-      text << " mu = " << h.mu << ": " << h.surface.angle << " deg"
+      text << " mu = " << h.mu << ": " << h.fit.angle << " ± " << h.fit.angle_error << " deg"
            << (h.rest < 0.0 ? " (still moving)" : "") << ';';
     }
     text << '\n';

@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 #include <string>
 #include <variant>
 
@@ -212,6 +213,76 @@ BeverlooFit fit_beverloo(std::span<const double> D, std::span<const double> W,
 double beverloo_rate(double C, double k, double rho_b, double g, double D, double d) {
   const double open = D - k * d;
   return open > 0.0 ? C * rho_b * std::sqrt(g) * std::pow(open, 2.5) : 0.0;
+}
+
+// [heap surface]
+HeapSurface heap_surface(const timestep::BodySystem& system, double L, double w) {
+  if (!(L > 0.0) || !(w > 0.0) || !(w <= 2.0 * L)) {
+    throw InvalidArgument("heap_surface: expected L > 0 and 0 < w <= 2 L, found L = " +
+                          format_number(L) + ", w = " + format_number(w));
+  }
+  HeapSurface s;
+  const auto bins = static_cast<std::size_t>(std::round(2.0 * L / w));
+  s.top.assign(bins, 0.0);
+  s.x.resize(bins);
+  for (std::size_t k = 0; k < bins; ++k) s.x[k] = -L + (static_cast<double>(k) + 0.5) * w;
+  const auto states = system.states();
+  for (std::size_t i = 0; i < states.size(); ++i) {
+    if (!system.dynamic(i)) continue;  // the base
+    const double k = std::floor((states[i].q[0] + L) / w);
+    if (k < 0.0 || k >= static_cast<double>(bins)) continue;
+    double& top = s.top[static_cast<std::size_t>(k)];
+    top = std::max(top, states[i].q[2]);
+  }
+  return s;
+}
+
+FlankFit fit_flanks(const HeapSurface& surface, double x_min, double x_max) {
+  std::vector<double> r, z;
+  for (std::size_t k = 0; k < surface.x.size(); ++k) {
+    const double distance = std::abs(surface.x[k]);
+    if (distance >= x_min && distance <= x_max && surface.top[k] > 0.0) {
+      r.push_back(distance);
+      z.push_back(surface.top[k]);
+    }
+  }
+  const auto n = static_cast<double>(r.size());
+  if (r.size() < 3) {
+    throw InvalidArgument("fit_flanks: expected at least 3 bins with bodies in " +
+                          format_number(x_min) + " <= |x| <= " + format_number(x_max) +
+                          ", found " + std::to_string(r.size()));
+  }
+  double r_mean = 0.0, z_mean = 0.0;
+  for (std::size_t k = 0; k < r.size(); ++k) {
+    r_mean += r[k] / n;
+    z_mean += z[k] / n;
+  }
+  double srr = 0.0, srz = 0.0;
+  for (std::size_t k = 0; k < r.size(); ++k) {
+    srr += (r[k] - r_mean) * (r[k] - r_mean);
+    srz += (r[k] - r_mean) * (z[k] - z_mean);
+  }
+  FlankFit fit;
+  fit.bins = r.size();
+  fit.b = srz / srr;
+  fit.a = z_mean - fit.b * r_mean;
+  double squares = 0.0;
+  for (std::size_t k = 0; k < r.size(); ++k) squares += std::pow(z[k] - fit.a - fit.b * r[k], 2);
+  fit.rms = std::sqrt(squares / n);
+  const double b_error = std::sqrt(squares / (n - 2.0) / srr);
+  constexpr double kDegree = 180.0 / std::numbers::pi;
+  fit.angle = std::atan(-fit.b) * kDegree;
+  fit.angle_error = b_error / (1.0 + fit.b * fit.b) * kDegree;  // d atan(b)/db
+  return fit;
+}
+// [heap surface]
+
+bool at_rest(const timestep::BodySystem& system, double speed) {
+  const auto states = system.states();
+  for (std::size_t i = 0; i < states.size(); ++i) {
+    if (system.dynamic(i) && states[i].u.head<3>().norm() >= speed) return false;
+  }
+  return true;
 }
 
 }  // namespace grbd::scene

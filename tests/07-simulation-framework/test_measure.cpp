@@ -279,3 +279,86 @@ TEST(JanssenFit, StressesOfJanssensLawGiveBackTheirLength) {
 }
 
 }  // namespace
+
+namespace {
+
+// A body system of spheres of radius 0.1 at the given centres (dynamic unless listed as fixed),
+// moving at the given speeds along x.
+grbd::timestep::BodySystem spheres(const std::vector<grbd::Vector3>& centres,
+                                   const std::vector<bool>& fixed = {},
+                                   const std::vector<double>& speed = {}) {
+  grbd::timestep::BodySystem system;
+  for (std::size_t i = 0; i < centres.size(); ++i) {
+    grbd::timestep::BodySpec spec;
+    spec.id = i;
+    spec.state.q << centres[i], 1.0, 0.0, 0.0, 0.0;
+    spec.state.u.setZero();
+    if (i < speed.size()) spec.state.u[0] = speed[i];
+    spec.inertia.m = 1.0;
+    spec.inertia.K_Theta = grbd::Vector3::Constant(0.004);
+    spec.shape = grbd::collision::Sphere{0.1};
+    spec.dynamic = !(i < fixed.size() && fixed[i]);
+    system.add(spec);
+  }
+  return system;
+}
+
+}  // namespace
+
+TEST(HeapSurface, TheFlanksOfAnExactHeapGiveItsAngle) {
+  // On both sides, the highest centre of each bin on z = a + b |x| with b = −tan 25°; a lower
+  // body below each, and a fixed body above all (the base is left out).
+  const double a = 0.3, b = -std::tan(25.0 * std::numbers::pi / 180.0);
+  std::vector<grbd::Vector3> centres;
+  for (int k = -4; k <= 4; ++k) {
+    const double x = 0.05 + 0.1 * k;  // bin centres of width 0.1 over [−0.5, 0.5]
+    centres.emplace_back(x, 0.0, a + b * std::abs(x));
+    centres.emplace_back(x, 0.0, a + b * std::abs(x) - 0.2);
+  }
+  centres.emplace_back(0.25, 0.0, 5.0);
+  std::vector<bool> fixed(centres.size(), false);
+  fixed.back() = true;
+  const auto system = spheres(centres, fixed);
+  const grbd::scene::HeapSurface surface = grbd::scene::heap_surface(system, 0.5, 0.1);
+  ASSERT_EQ(surface.x.size(), 10U);
+  EXPECT_EQ(surface.top[0], 0.0);  // the bin [−0.5, −0.4) holds nothing
+  const grbd::scene::FlankFit fit = grbd::scene::fit_flanks(surface, 0.1, 0.5);
+  EXPECT_EQ(fit.bins, 7U);  // 9 bins hold bodies; the two at |x| = 0.05 are left out
+  EXPECT_NEAR(fit.a, a, 1e-12);
+  EXPECT_NEAR(fit.b, b, 1e-12);
+  EXPECT_NEAR(fit.angle, 25.0, 1e-10);
+  EXPECT_LT(fit.angle_error, 1e-9);
+  EXPECT_LT(fit.rms, 1e-12);
+}
+
+TEST(HeapSurface, ScatterGivesTheLeastSquaresStandardError) {
+  // One flank, |x| = 1.5 … 5.5, with residuals δ (1, −2, 0, 2, −1): orthogonal to 1 and to |x|,
+  // so the line is unchanged, and Σ residual² = 10 δ², Σ(r − r̄)² = 10: the standard error of
+  // the slope is √(10 δ²/3 / 10) = δ/√3, that of the angle δ/√3/(1 + b²).
+  const double a = 4.0, b = -0.5, delta = 0.01;
+  const double e[] = {1.0, -2.0, 0.0, 2.0, -1.0};
+  std::vector<grbd::Vector3> centres;
+  for (int k = 0; k < 5; ++k) {
+    const double r = 1.5 + k;
+    centres.emplace_back(r, 0.0, a + b * r + delta * e[k]);
+  }
+  const auto fit = grbd::scene::fit_flanks(grbd::scene::heap_surface(spheres(centres), 6.0, 1.0),
+                                           1.0, 6.0);
+  EXPECT_EQ(fit.bins, 5U);
+  EXPECT_NEAR(fit.b, b, 1e-12);
+  EXPECT_NEAR(fit.rms, delta * std::sqrt(2.0), 1e-12);
+  EXPECT_NEAR(fit.angle_error, delta / std::sqrt(3.0) / 1.25 * 180.0 / std::numbers::pi, 1e-10);
+  // Too few bins, and a bad window, are refused.
+  EXPECT_THROW(grbd::scene::fit_flanks(grbd::scene::heap_surface(spheres(centres), 6.0, 1.0), 4.0,
+                                       5.0),
+               InvalidArgument);
+  EXPECT_THROW(grbd::scene::heap_surface(spheres(centres), 1.0, 3.0), InvalidArgument);
+}
+
+TEST(AtRest, EveryDynamicBodyBelowTheSpeed) {
+  // A fixed body's velocity does not count (it never moves).
+  const auto system = spheres({{0, 0, 0}, {1, 0, 0}, {2, 0, 0}}, {false, false, true},
+                              {0.0, 0.002, 0.5});
+  EXPECT_FALSE(grbd::scene::at_rest(system, 0.001));
+  EXPECT_TRUE(grbd::scene::at_rest(system, 0.003));
+}

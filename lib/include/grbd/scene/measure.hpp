@@ -2,7 +2,8 @@
 /// \file
 /// \brief Measurements of granular experiments (chapter 7): Love's mean stress in horizontal
 /// slices from the contact percussions, the Janssen length, a steady rate from a cumulative
-/// series (a silo's mass flow), and Beverloo's law fitted to flow rates.
+/// series (a silo's mass flow), Beverloo's law fitted to flow rates, and the surface and angle of
+/// a heap.
 
 #include <cstddef>
 #include <span>
@@ -83,5 +84,33 @@ BeverlooFit fit_beverloo(std::span<const double> D, std::span<const double> W,
 
 /// W = C ρ_b √g (D − k d)^(5/2), 0 when D ≤ k d [kg/s].
 double beverloo_rate(double C, double k, double rho_b, double g, double D, double d);
+
+/// The free surface of a heap along x: in bins of width w over [−L, L], the highest centre of a
+/// dynamic body (0 in a bin with none); fixed bodies (a rough base) are left out.
+struct HeapSurface {
+  std::vector<double> x;    ///< bin centres [m]
+  std::vector<double> top;  ///< the highest centre in each [m]
+};
+
+/// The surface of the heap in `system`. Throws InvalidArgument unless L > 0 and 0 < w ≤ 2L.
+HeapSurface heap_surface(const timestep::BodySystem& system, double L, double w);
+
+/// The flanks of a heap as one straight line z = a + b |x| over the bins with
+/// x_min ≤ |x| ≤ x_max and a body (both flanks together, a symmetric heap).
+struct FlankFit {
+  double a = 0.0;            ///< height at the axis [m]
+  double b = 0.0;            ///< slope (< 0 for a heap)
+  double angle = 0.0;        ///< atan(−b) [degrees]
+  double angle_error = 0.0;  ///< its least-squares standard error [degrees]
+  double rms = 0.0;          ///< of the residuals [m]
+  std::size_t bins = 0;      ///< bins in the fit
+};
+
+/// Least squares over the flank bins; the standard error of b is s/√Σ(r − r̄)² with
+/// s² = Σ residual²/(n − 2). Throws InvalidArgument for fewer than 3 bins in the window.
+FlankFit fit_flanks(const HeapSurface& surface, double x_min, double x_max);
+
+/// True when every dynamic body moves slower than `speed` [m/s] (its centre's velocity).
+bool at_rest(const timestep::BodySystem& system, double speed);
 
 }  // namespace grbd::scene
