@@ -37,9 +37,9 @@ plot for [k=1:heaps] profile using (1e3*$1):(1e3*column(k+1) > 0 ? 1e3*column(k+
        with lines lw 1.5 lc k notitle
 set xlabel "friction coefficient μ between the beads"
 set ylabel "angle of repose θ [degrees]"
-set key bottom right
+set key top left opaque box font 'sans,10'
 set xrange [-0.05:1.05]
-set yrange [0:*]
+set yrange [0:60]  # room for the key above atan(1) = 45°
 set samples 200
 plot table using 1:2:3 with yerrorbars pt 7 ps 0.9 lc rgb "#0072b2" title "heap at rest", \
      atan(x) * 180 / pi with lines lw 1 dt 2 lc rgb "#000000" title "one sliding contact: atan μ", \
