@@ -101,7 +101,18 @@ class OverlapGrid {
   }
 
  private:
-  Eigen::Array3i cell(const Vector3& c) const { return (c.array() / h_).floor().cast<int>(); }
+  // The clamp comes before the conversion (converting a double outside the range of int is
+  // undefined, and so is k ± 1 at its ends): far cells share the clamped one, which only adds
+  // candidates, since |clamp(a) − clamp(b)| ≤ |a − b| keeps neighbours neighbours. NaN → 0.
+  Eigen::Array3i cell(const Vector3& c) const {
+    constexpr double kLimit = 0x1p30;
+    Eigen::Array3i k;
+    for (int axis = 0; axis < 3; ++axis) {
+      const double t = std::floor(c[axis] / h_);
+      k[axis] = std::isnan(t) ? 0 : static_cast<int>(std::clamp(t, -kLimit, kLimit));
+    }
+    return k;
+  }
   static std::uint64_t key(const Eigen::Array3i& k) {
     const auto part = [](int v) {
       return static_cast<std::uint64_t>(static_cast<std::uint32_t>(v)) & 0x1FFFFF;
