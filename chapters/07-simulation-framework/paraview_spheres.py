@@ -1,15 +1,17 @@
 """Render the bodies of a grbd run as spheres with ParaView (chapter 7), without a window.
 
 Usage:
-    xvfb-run -a pvbatch paraview_spheres.py RUN.xmf IMAGE.png [RECORD]
+    headless.py Xvfb pvbatch paraview_spheres.py RUN.xmf IMAGE.png [RECORD]
+    (or, on a machine with a display: pvbatch paraview_spheres.py RUN.xmf IMAGE.png [RECORD])
 
 Opens the XDMF description beside a grbd output file, draws every body as a sphere of its own
 radius (the Glyph filter, scaled by the record's `radius`), colours the spheres by the magnitude
 of their velocity, and saves the last record (or record number RECORD, from 0) as a PNG image
 seen from the side, a little from above. These are the steps the chapter describes for the
 ParaView window. ParaView is not a dependency of grbd: Debian 12 packages it as `paraview` and
-`python3-paraview` (pvbatch); its build renders through GLX, hence the virtual X server of
-xvfb-run (and Mesa's software renderer, libgl1-mesa-dri) on a machine without a display.
+`python3-paraview` (pvbatch); its build renders through GLX, hence a virtual X server (Xvfb,
+started by headless.py beside this script) and Mesa's software renderer (libgl1-mesa-dri) on a
+machine without a display.
 """
 
 import sys
