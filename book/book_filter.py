@@ -10,8 +10,8 @@ numbers of the source (so Doxygen's warnings still point at the right line):
 - Figures `\\image html NAME.svg "caption"` (or NAME.png) are numbered per chapter ("Figure N.k: caption") and
   get the anchor `fig_NAME`; `\\figref{NAME}` in the text becomes a link "Figure N.k".
 - Optional parts `\\if NAME` ... [`\\else` ...] `\\endif` (lines of their own, outside code
-  blocks) are resolved here, against the sections given by `--sections=NAME,...` (Doxygen's
-  ENABLED_SECTIONS, which the build sets from the tools it found): the lines of the branch not
+  blocks) are resolved here, against the sections given by `--sections=NAME,...` (which the build
+  sets from the tools it found, in place of Doxygen's ENABLED_SECTIONS): the lines of the branch not
   taken, and the directives, become empty lines, so figures are numbered as the reader sees them.
 - Every chapter gets previous/next links, at the top (in place of the blank line after the title)
   and at the bottom, following the order of the chapter folders; the last chapter leads to the

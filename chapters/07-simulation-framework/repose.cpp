@@ -123,12 +123,8 @@ int main(int argc, char** argv) {
           std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
       measure(sim, heap);
       heap.fell = sim.bodies_removed();
-      const auto states = sim.system().states();
-      for (std::size_t i = 0; i < states.size(); ++i) {
-        if (!sim.system().dynamic(i)) continue;
-        ++heap.beads;
-        heap.max_speed = std::max(heap.max_speed, states[i].u.head<3>().norm());
-      }
+      for (std::size_t i = 0; i < sim.system().size(); ++i) heap.beads += sim.system().dynamic(i);
+      heap.max_speed = grbd::scene::max_speed(sim.system());
       std::cout << kProgram << ": mu = " << mu << ": angle " << heap.fit.angle << " ± "
                 << heap.fit.angle_error << " degrees (rms " << heap.fit.rms * 1e3 << " mm), "
                 << heap.beads << " beads on the table, " << heap.fell << " fell off, fastest "

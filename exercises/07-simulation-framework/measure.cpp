@@ -26,9 +26,16 @@ void require_same_length(const char* where, std::size_t a, std::size_t b) {
   }
 }
 
-// The least-squares slope of the points (x_k, y_k), k ∈ [first, last).
-double slope(std::span<const double> x, std::span<const double> y, std::size_t first,
-             std::size_t last) {
+// The least-squares line y = intercept + slope x through the points (x_k, y_k),
+// k ∈ [first, last), with sxx = Σ(x_k − x̄)², which its standard errors need.
+struct Line {
+  double slope = 0.0;
+  double intercept = 0.0;
+  double sxx = 0.0;
+};
+
+Line fit_line(std::span<const double> x, std::span<const double> y, std::size_t first,
+              std::size_t last) {
   const auto n = static_cast<double>(last - first);
   double mx = 0.0, my = 0.0;
   for (std::size_t k = first; k < last; ++k) {
@@ -42,16 +49,26 @@ double slope(std::span<const double> x, std::span<const double> y, std::size_t f
     sxy += (x[k] - mx) * (y[k] - my);
     sxx += (x[k] - mx) * (x[k] - mx);
   }
-  return sxy / sxx;
+  const double slope = sxy / sxx;
+  return {slope, my - slope * mx, sxx};
+}
+
+// The least-squares slope of the points (x_k, y_k), k ∈ [first, last).
+double slope(std::span<const double> x, std::span<const double> y, std::size_t first,
+             std::size_t last) {
+  return fit_line(x, y, first, last).slope;
+}
+
+// The bin of width h from v0 that v falls in, or count outside [v0, v0 + count h) (and for NaN).
+std::size_t bin_of(double v, double v0, double h, std::size_t count) {
+  const double k = std::floor((v - v0) / h);
+  if (!(k >= 0.0) || k >= static_cast<double>(count)) return count;
+  return static_cast<std::size_t>(k);
 }
 
 }  // namespace
 
-std::size_t Slices::slice_of(double z) const {
-  const double k = std::floor((z - z0) / h);
-  if (!(k >= 0.0) || k >= static_cast<double>(count)) return count;
-  return static_cast<std::size_t>(k);
-}
+std::size_t Slices::slice_of(double z) const { return bin_of(z, z0, h, count); }
 
 double silo_width(const Scene& scene) {
   double lo = INFINITY, hi = -INFINITY;
@@ -229,10 +246,8 @@ HeapSurface heap_surface(const timestep::BodySystem& system, double L, double w)
   const auto states = system.states();
   for (std::size_t i = 0; i < states.size(); ++i) {
     if (!system.dynamic(i)) continue;  // the base
-    const double k = std::floor((states[i].q[0] + L) / w);
-    if (k < 0.0 || k >= static_cast<double>(bins)) continue;
-    double& top = s.top[static_cast<std::size_t>(k)];
-    top = std::max(top, states[i].q[2]);
+    const std::size_t k = bin_of(states[i].q[0], -L, w, bins);
+    if (k < bins) s.top[k] = std::max(s.top[k], states[i].q[2]);
   }
   return s;
 }
@@ -252,24 +267,15 @@ FlankFit fit_flanks(const HeapSurface& surface, double x_min, double x_max) {
                           format_number(x_min) + " <= |x| <= " + format_number(x_max) +
                           ", found " + std::to_string(r.size()));
   }
-  double r_mean = 0.0, z_mean = 0.0;
-  for (std::size_t k = 0; k < r.size(); ++k) {
-    r_mean += r[k] / n;
-    z_mean += z[k] / n;
-  }
-  double srr = 0.0, srz = 0.0;
-  for (std::size_t k = 0; k < r.size(); ++k) {
-    srr += (r[k] - r_mean) * (r[k] - r_mean);
-    srz += (r[k] - r_mean) * (z[k] - z_mean);
-  }
+  const Line line = fit_line(r, z, 0, r.size());
   FlankFit fit;
   fit.bins = r.size();
-  fit.b = srz / srr;
-  fit.a = z_mean - fit.b * r_mean;
+  fit.b = line.slope;
+  fit.a = line.intercept;
   double squares = 0.0;
   for (std::size_t k = 0; k < r.size(); ++k) squares += std::pow(z[k] - fit.a - fit.b * r[k], 2);
   fit.rms = std::sqrt(squares / n);
-  const double b_error = std::sqrt(squares / (n - 2.0) / srr);
+  const double b_error = std::sqrt(squares / (n - 2.0) / line.sxx);
   constexpr double kDegree = 180.0 / std::numbers::pi;
   fit.angle = std::atan(-fit.b) * kDegree;
   fit.angle_error = b_error / (1.0 + fit.b * fit.b) * kDegree;  // d atan(b)/db
@@ -277,12 +283,17 @@ FlankFit fit_flanks(const HeapSurface& surface, double x_min, double x_max) {
 }
 // [heap surface]
 
-bool at_rest(const timestep::BodySystem& system, double speed) {
+double max_speed(const timestep::BodySystem& system) {
+  double fastest = 0.0;
   const auto states = system.states();
   for (std::size_t i = 0; i < states.size(); ++i) {
-    if (system.dynamic(i) && states[i].u.head<3>().norm() >= speed) return false;
+    if (system.dynamic(i)) fastest = std::max(fastest, states[i].u.head<3>().norm());
   }
-  return true;
+  return fastest;
+}
+
+bool at_rest(const timestep::BodySystem& system, double speed) {
+  return max_speed(system) < speed;
 }
 
 }  // namespace grbd::scene

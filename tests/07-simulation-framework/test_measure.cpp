@@ -359,6 +359,7 @@ TEST(AtRest, EveryDynamicBodyBelowTheSpeed) {
   // A fixed body's velocity does not count (it never moves).
   const auto system = spheres({{0, 0, 0}, {1, 0, 0}, {2, 0, 0}}, {false, false, true},
                               {0.0, 0.002, 0.5});
+  EXPECT_EQ(grbd::scene::max_speed(system), 0.002);
   EXPECT_FALSE(grbd::scene::at_rest(system, 0.001));
   EXPECT_TRUE(grbd::scene::at_rest(system, 0.003));
 }

@@ -110,7 +110,10 @@ struct FlankFit {
 /// s² = Σ residual²/(n − 2). Throws InvalidArgument for fewer than 3 bins in the window.
 FlankFit fit_flanks(const HeapSurface& surface, double x_min, double x_max);
 
-/// True when every dynamic body moves slower than `speed` [m/s] (its centre's velocity).
+/// The largest speed |I_v_S| of a dynamic body [m/s] (0 without one).
+double max_speed(const timestep::BodySystem& system);
+
+/// True when every dynamic body moves slower than `speed` [m/s]: max_speed(system) < speed.
 bool at_rest(const timestep::BodySystem& system, double speed);
 
 }  // namespace grbd::scene
