@@ -507,6 +507,71 @@ TEST(Stepper, RefusesBadSettingsMissingMaterialPairsAndUnsupportedShapePairs) {
   }
 }
 
+// A blow-up is an error, not data: a step that leaves a state or an energy outside the doubles
+// throws, naming the step, the time and the body's id, whether or not the body has a contact.
+TEST(Stepper, AStepThatBlowsUpThrowsNamingStepTimeAndBody) {
+  const auto message_of_first_step = [](BodySpec spec, double dt, bool with_floor) {
+    BodySystem system;
+    system.add(sphere_body(5, 0.1, Vector3(3.0, 0.0, 1.0)));  // a quiet neighbour
+    system.add(spec);
+    StaticGeometry statics;
+    if (with_floor) statics.add(demo::floor_object());
+    const MaterialTable materials = demo::one_material(0.5);
+    MoreauStepper stepper(system, statics, materials, tight(dt));
+    try {
+      stepper.step();
+    } catch (const Error& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  BodySpec spin = sphere_body(7, 0.1, Vector3(0.0, 0.0, 1.0));
+  spin.state.u << 0.0, 0.0, 0.0, 1e308, 1e308, 0.0;  // |ω| overflows in the exponential map
+  EXPECT_EQ(message_of_first_step(spin, 1.0, false).rfind(
+                "MoreauStepper: step 1 (t = 1 s): body 7 blew up", 0),
+            0U) << message_of_first_step(spin, 1.0, false);
+  BodySpec fast = sphere_body(9, 0.1, Vector3(0.0, 0.0, 1.0));
+  fast.state.u << 1e308, 0.0, 0.0, 0.0, 0.0, 0.0;  // finite, but q overflows in Δt = 10 s
+  const std::string m = message_of_first_step(fast, 10.0, true);
+  EXPECT_EQ(m.rfind("MoreauStepper: step 1 (t = 10 s): body 9 blew up", 0), 0U) << m;
+  // Every body finite, but the system's energy overflows: named as such.
+  BodySpec heavy = sphere_body(11, 0.1, Vector3(0.0, 0.0, 1.0));
+  heavy.state.u << 1e154, 1e154, 1e154, 0.0, 0.0, 0.0;
+  heavy.inertia.m = 1e10;
+  heavy.inertia.K_Theta = Vector3::Constant(1e8);
+  EXPECT_NE(message_of_first_step(heavy, 1e-6, false).find("kinetic energy inf"),
+            std::string::npos);
+}
+
+TEST(Stepper, AStateSetFromOutsideThatIsNotFiniteIsNamedByItsId) {
+  BodySystem system;
+  system.add(sphere_body(3, 0.1, Vector3(0.0, 0.0, 1.0)));
+  system.add(sphere_body(4, 0.1, Vector3(1.0, 0.0, 1.0)));
+  StaticGeometry statics;
+  const MaterialTable materials = demo::one_material(0.5);
+  MoreauStepper stepper(system, statics, materials, tight(1e-3));
+  system.states()[system.index_of(4)].q[2] = -std::numeric_limits<double>::infinity();
+  try {
+    stepper.step();
+    ADD_FAILURE() << "an infinite position was stepped";
+  } catch (const Error& e) {
+    const std::string m = e.what();
+    EXPECT_EQ(m.rfind("MoreauStepper: step 1 (t = 0.001 s): ", 0), 0U) << m;
+    EXPECT_NE(m.find("body 4 blew up at the midpoint"), std::string::npos) << m;
+  }
+  EXPECT_THROW(stepper.set_clock(-5.0, 0), InvalidArgument);
+}
+
+TEST(Stepper, RefusesBodiesWhoseMassOrInertiaHasNoFiniteInverse) {
+  BodySystem system;
+  BodySpec tiny = sphere_body(1, 0.1, Vector3(0.0, 0.0, 1.0));
+  tiny.inertia.m = 5e-324;  // positive and finite, but 1/m = inf
+  EXPECT_THROW(system.add(tiny), InvalidArgument);
+  tiny = sphere_body(1, 0.1, Vector3(0.0, 0.0, 1.0));
+  tiny.inertia.K_Theta = Vector3::Constant(1e-310);
+  EXPECT_THROW(system.add(tiny), InvalidArgument);
+}
+
 TEST(Stepper, ReportsEnergiesPenetrationAndStageTimes) {
   BodySystem system;
   system.add(sphere_body(1, 0.1, Vector3(0.0, 0.0, 0.09)));  // 1 cm into the floor

@@ -18,15 +18,18 @@
 namespace grbd::body {
 
 void require_valid(const RigidBody& body, std::string_view where) {
-  if (!(body.m > 0.0) || !std::isfinite(body.m)) {
-    throw InvalidArgument(
-        std::string(where) +
-        ": the mass m must be positive and finite, but m = " + format_number(body.m));
+  // The step divides by m and K_Θ: a subnormal value is positive but its inverse overflows.
+  const auto invertible = [](double x) { return x > 0.0 && std::isfinite(x) && std::isfinite(1.0 / x); };
+  if (!invertible(body.m)) {
+    throw InvalidArgument(std::string(where) +
+                          ": the mass m must be positive and finite with a finite inverse, but m = " +
+                          format_number(body.m));
   }
   for (int i = 0; i < 3; ++i) {
-    if (!(body.K_Theta[i] > 0.0) || !std::isfinite(body.K_Theta[i])) {
+    if (!invertible(body.K_Theta[i])) {
       throw InvalidArgument(std::string(where) + ": the principal moment K_Theta[" +
-                            std::to_string(i) + "] must be positive and finite, but it is " +
+                            std::to_string(i) +
+                            "] must be positive and finite with a finite inverse, but it is " +
                             format_number(body.K_Theta[i]));
     }
   }

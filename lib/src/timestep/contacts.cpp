@@ -110,6 +110,12 @@ void ContactDetector::detect(const BodySystem& system, const StaticGeometry& sta
   placements_.resize(n);
   for (std::size_t i = 0; i < n; ++i) {
     const Vector7& q = states[i].q;
+    if (!q.allFinite()) {
+      throw InvalidArgument("ContactDetector::detect: expected finite positions and orientations, "
+                            "found q = (" + format_number(q[0]) + ", " + format_number(q[1]) +
+                            ", " + format_number(q[2]) + ", …) for body " +
+                            std::to_string(ids[i]));
+    }
     placements_[i] = {kinematics::position(q),
                       kinematics::rotation_matrix(kinematics::orientation(q))};
   }

@@ -79,8 +79,8 @@ MoreauStepper::MoreauStepper(BodySystem& system, const StaticGeometry& statics,
 }
 
 void MoreauStepper::set_clock(double t, std::uint64_t steps) {
-  if (!std::isfinite(t)) {
-    throw InvalidArgument("MoreauStepper::set_clock: expected a finite time, found " +
+  if (!std::isfinite(t) || !(t >= 0.0)) {
+    throw InvalidArgument("MoreauStepper::set_clock: expected a finite time t >= 0, found " +
                           format_number(t));
   }
   t_ = t;
@@ -185,9 +185,13 @@ StepReport MoreauStepper::step() {
   report.t = t_ + dt;
 
   // 1. The midpoint q_M = q_S + Δt/2 F(q_S) u_S, the loads there, u_free = u_S + Δt M⁻¹ h.
+  bool finite = true;
   for (std::size_t i = 0; i < n; ++i) {
-    if (system_.dynamic(i)) states[i].q = half(states[i].q, states[i].u);
+    if (!system_.dynamic(i)) continue;
+    states[i].q = half(states[i].q, states[i].u);
+    finite = finite && states[i].q.allFinite();
   }
+  if (!finite) require_finite(report, " at the midpoint");
   loads_.assign(n, body::Loads{});
   if (external_loads) {
     external_loads(t_ + 0.5 * dt, system_, loads_);
@@ -223,7 +227,12 @@ StepReport MoreauStepper::step() {
   const auto t1 = Clock::now();
 
   // 2. Contacts at the midpoint; Moreau's active set g_N(q_M) ≤ 0 (to the tolerance).
-  detector_.detect(system_, statics_, tolerance_, contacts_, keys_);
+  try {
+    detector_.detect(system_, statics_, tolerance_, contacts_, keys_);
+  } catch (const InvalidArgument& e) {  // a state set from outside that is not finite
+    throw Error("MoreauStepper: step " + std::to_string(report.step) + " (t = " +
+                format_number(report.t) + " s): " + e.what());
+  }
   std::size_t active = 0;
   for (std::size_t k = 0; k < contacts_.size(); ++k) {
     if (!is_active(contacts_[k].geometry, tolerance_)) continue;
@@ -325,10 +334,19 @@ StepReport MoreauStepper::step() {
   }
   if (settings_.drift_correction > 0.0) correct_drift();
   if (settings_.warm_start) warm_.store(keys_, solution_.lambda);
+  const auto radii = system_.bounding_radii();
   for (std::size_t i = 0; i < n; ++i) {
     if (!system_.dynamic(i)) continue;
     report.kinetic_energy += body::kinetic_energy(inertia[i], states[i].u);
     report.potential_energy -= inertia[i].m * settings_.I_g.dot(states[i].q.head<3>());
+    finite = finite && states[i].q.head<3>().cwiseAbs().maxCoeff() <= kFarthest * radii[i] &&
+             states[i].q.tail<4>().allFinite();
+  }
+  // A blow-up is an error, not data: a state or an energy that left the doubles (a NaN or an
+  // infinity in q or u makes one of the energies non-finite, 0 · ∞ included), or a body so far
+  // out that the doubles no longer resolve its size (the comparison is false for NaN, too).
+  if (!finite || !std::isfinite(report.kinetic_energy) || !std::isfinite(report.potential_energy)) {
+    require_finite(report, "");
   }
   for (const DetectedContact& c : contacts_) {
     report.max_penetration = std::max(report.max_penetration, -c.geometry.g_N);
@@ -341,6 +359,39 @@ StepReport MoreauStepper::step() {
   return report;
 }
 // [step]
+
+// Names the first body whose state or energy is not finite in the step of `report` (`where`: ""
+// after the step, " at the midpoint" after its first half).
+void MoreauStepper::require_finite(const StepReport& report, const char* where) const {
+  const auto states = system_.states();
+  const auto inertia = system_.inertia();
+  const std::string when = "MoreauStepper: step " + std::to_string(report.step) + " (t = " +
+                           format_number(report.t) + " s): ";
+  const std::string energies = "kinetic energy " + format_number(report.kinetic_energy) +
+                               " J, potential energy " + format_number(report.potential_energy) +
+                               " J";
+  const auto radii = system_.bounding_radii();
+  for (std::size_t i = 0; i < system_.size(); ++i) {
+    const body::State& x = states[i];
+    const double e = body::kinetic_energy(inertia[i], x.u) -
+                     inertia[i].m * settings_.I_g.dot(x.q.head<3>());
+    const bool far = !(x.q.head<3>().cwiseAbs().maxCoeff() <= kFarthest * radii[i]);
+    if (!system_.dynamic(i) || (x.q.allFinite() && std::isfinite(e) && !far)) continue;
+    std::string text = when + id_name(system_.ids()[i]) + " blew up" + where +
+                       (x.q.allFinite() && std::isfinite(e)
+                            ? ": it is more than 10¹² bounding radii from the origin, where "
+                              "doubles no longer resolve its size"
+                            : ": its state or its energy is no longer finite") +
+                       " (check the time step, the loads and the initial velocities): q = (";
+    for (int d = 0; d < 7; ++d) text += (d ? ", " : "") + format_number(x.q[d]);
+    text += "), u = (";
+    for (int d = 0; d < 6; ++d) text += (d ? ", " : "") + format_number(x.u[d]);
+    throw Error(text + "); " + energies);
+  }
+  throw Error(when + "the energy of the system overflows (" + energies +
+              "), though every body's state is finite: the velocities or positions are too "
+              "large for doubles");
+}
 
 // [drift correction]
 void MoreauStepper::correct_drift() {

@@ -31,6 +31,11 @@ enum class NonConvergence {
   stop,   ///< throw grbd::Error naming the step, time, iterations and residual
 };
 
+/// The farthest a dynamic body's centre may be from the origin after a step, in its bounding
+/// radii: beyond it the spacing of the doubles exceeds 2·10⁻⁴ of its radius, contact geometry is
+/// noise, and MoreauStepper::step() reports a blow-up.
+inline constexpr double kFarthest = 1e12;
+
 /// How the two half steps move the orientation.
 enum class OrientationUpdate {
   exponential_map,    ///< p ← p exp_S3(Δt/4 ω): stays on |p| = 1 (half_step())
@@ -102,14 +107,18 @@ class MoreauStepper {
                 StepSettings settings = {});
 
   /// One step of length Δt; returns its report. Throws grbd::Error when the solver diverges or
-  /// (NonConvergence::stop) does not converge; the system is then left at the midpoint state.
+  /// (NonConvergence::stop) does not converge, the system then left at the midpoint state; and
+  /// when the step leaves a body's q or u, or the kinetic or potential energy, not finite, or a
+  /// dynamic body farther than kFarthest bounding radii from the origin (a blow-up), naming the
+  /// step, the time and the body's id: the system then holds that state, which must not be
+  /// continued.
   StepReport step();
 
   /// Time [s] at the end of the last step.
   double time() const { return t_; }
   /// Number of steps done.
   std::uint64_t steps() const { return steps_; }
-  /// Sets the clock (restart).
+  /// Sets the clock (restart); throws InvalidArgument unless t is finite and ≥ 0.
   void set_clock(double t, std::uint64_t steps);
   /// Steps that did not converge so far.
   std::uint64_t non_converged_steps() const { return non_converged_; }
@@ -136,6 +145,7 @@ class MoreauStepper {
  private:
   void check_layout();
   void correct_drift();
+  [[noreturn]] void require_finite(const StepReport& report, const char* where) const;
 
   BodySystem& system_;
   const StaticGeometry& statics_;
