@@ -218,15 +218,14 @@ std::size_t StaticGeometry::add(StaticObject object) {
     throw InvalidArgument(where + ": expected an id below 2^63, found " +
                           std::to_string(object.id));
   }
-  for (const StaticObject& other : objects_) {
-    if (other.id == object.id) {
-      throw InvalidArgument(where + ": the id " + std::to_string(object.id) + " is used twice");
-    }
+  if (ids_.contains(object.id)) {
+    throw InvalidArgument(where + ": the id " + std::to_string(object.id) + " is used twice");
   }
   if (!object.pose.I_r.allFinite() || !kinematics::is_rotation_matrix(object.pose.A_IC, 1e-9)) {
     throw InvalidArgument(where + ": expected a finite position and a rotation matrix A_IC");
   }
   collision::normalize_and_check(object.shape, where);
+  ids_.insert(object.id);
   objects_.push_back(std::move(object));
   return objects_.size() - 1;
 }

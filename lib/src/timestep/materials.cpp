@@ -3,6 +3,7 @@
 
 #include "grbd/timestep/materials.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include "grbd/core/checks.hpp"
@@ -40,18 +41,22 @@ MaterialId MaterialTable::add(std::string_view name) {
                           " materials, found one more: \"" + std::string(name) + "\"");
   }
   const std::size_t old_n = size();
-  const std::size_t n = old_n + 1;
-  std::vector<std::uint32_t> table(n * n, kNone);
-  std::vector<std::uint8_t> set(n * n, 0);
-  for (std::size_t a = 0; a < old_n; ++a) {
-    for (std::size_t b = 0; b < old_n; ++b) {
-      table[a * n + b] = table_[a * old_n + b];
-      set[a * n + b] = set_[a * old_n + b];
+  if (old_n == stride_) {
+    const std::size_t stride = std::max<std::size_t>(8, 2 * stride_);
+    std::vector<std::uint32_t> table(stride * stride, kNone);
+    std::vector<std::uint8_t> set(stride * stride, 0);
+    for (std::size_t a = 0; a < old_n; ++a) {
+      for (std::size_t b = 0; b < old_n; ++b) {
+        table[a * stride + b] = table_[a * stride_ + b];
+        set[a * stride + b] = set_[a * stride_ + b];
+      }
     }
+    table_.swap(table);
+    set_.swap(set);
+    stride_ = stride;
   }
-  table_.swap(table);
-  set_.swap(set);
   names_.emplace_back(name);
+  ids_.emplace(names_.back(), static_cast<MaterialId>(old_n));
   return static_cast<MaterialId>(old_n);
 }
 
@@ -66,7 +71,7 @@ void MaterialTable::set_pair(MaterialId a, MaterialId b, const contact::ContactM
   require_known(a, "MaterialTable::set_pair");
   require_known(b, "MaterialTable::set_pair");
   require_law(law, "MaterialTable::set_pair (\"" + names_[a] + "\", \"" + names_[b] + "\")");
-  const std::size_t n = size();
+  const std::size_t n = stride_;
   std::uint32_t slot = table_[a * n + b];
   if (slot == kNone) {
     laws_.push_back(law);
@@ -87,7 +92,7 @@ void MaterialTable::set_default(const contact::ContactMaterial& law) {
 const contact::ContactMaterial& MaterialTable::pair(MaterialId a, MaterialId b) const {
   require_known(a, "MaterialTable::pair");
   require_known(b, "MaterialTable::pair");
-  if (!set_[a * size() + b] && !has_default_) {
+  if (!set_[a * stride_ + b] && !has_default_) {
     throw InvalidArgument("MaterialTable: no contact law for the pair of materials \"" +
                           names_[a] + "\" and \"" + names_[b] +
                           "\" and no default declared: set the pair or a default");
@@ -110,10 +115,9 @@ const std::string& MaterialTable::name(MaterialId id) const {
 }
 
 std::optional<MaterialId> MaterialTable::find(std::string_view name) const {
-  for (std::size_t i = 0; i < names_.size(); ++i) {
-    if (names_[i] == name) return static_cast<MaterialId>(i);
-  }
-  return std::nullopt;
+  const auto it = ids_.find(std::string(name));
+  if (it == ids_.end()) return std::nullopt;
+  return it->second;
 }
 
 }  // namespace grbd::timestep

@@ -8,6 +8,7 @@
 #include <span>
 #include <string>
 #include <string_view>
+#include <unordered_map>
 #include <vector>
 
 #include "grbd/contact/problem.hpp"
@@ -22,8 +23,9 @@ class MaterialTable {
  public:
   /// At most this many materials: the pair table is dense (n² entries).
   static constexpr std::size_t kMaxMaterials = 1024;
-  /// Adds a material and returns its id (0, 1, …). Throws InvalidArgument for an empty name, a
-  /// name used twice, or more than kMaxMaterials materials.
+  /// Adds a material and returns its id (0, 1, …); amortised O(1) plus the copy of the pair table
+  /// when its capacity doubles. Throws InvalidArgument for an empty name, a name used twice, or
+  /// more than kMaxMaterials materials.
   MaterialId add(std::string_view name);
   /// Sets the law of the pair {a, b}. Throws InvalidArgument, naming both materials, for an
   /// unknown id, μ < 0 or not finite, ε_N ∉ [0, 1], ε_T ∉ [−1, 1].
@@ -36,14 +38,14 @@ class MaterialTable {
   /// The law of {a, b} without the checks: the ids are known and require_pairs() accepted them.
   /// O(1), one load: what the assembly calls per contact.
   const contact::ContactMaterial& pair_unchecked(MaterialId a, MaterialId b) const {
-    return laws_[table_[a * size() + b]];
+    return laws_[table_[a * stride_ + b]];
   }
   /// Throws InvalidArgument unless every pair (x, y), x from `a` and y from `b`, has a law, naming
   /// the first pair without one; and unless every id is known.
   void require_pairs(std::span<const MaterialId> a, std::span<const MaterialId> b) const;
   /// The name of a material.
   const std::string& name(MaterialId id) const;
-  /// The id of the material with this name, if any.
+  /// The id of the material with this name, if any (O(1): a hash of the names).
   std::optional<MaterialId> find(std::string_view name) const;
   /// Number of materials.
   std::size_t size() const { return names_.size(); }
@@ -54,8 +56,12 @@ class MaterialTable {
   std::vector<std::string> names_;
   std::vector<contact::ContactMaterial> laws_{contact::ContactMaterial{}};  // [0]: default
   bool has_default_ = false;
-  std::vector<std::uint32_t> table_;  // size() × size(): index into laws_, kNone for "default"
-  std::vector<std::uint8_t> set_;     // size() × size(): 1 where an entry was set
+  std::unordered_map<std::string, MaterialId> ids_;  // name → id
+  // stride_ × stride_, of which size() × size() is used; stride_ doubles when full, so that n
+  // materials cost O(n²) in all, not O(n³).
+  std::size_t stride_ = 0;
+  std::vector<std::uint32_t> table_;  // index into laws_, kNone for "default"
+  std::vector<std::uint8_t> set_;     // 1 where an entry was set
 };
 
 }  // namespace grbd::timestep
