@@ -145,6 +145,7 @@ int main(int argc, char** argv) {
     grbd::io::RunOptions options;
     options.output = dir / "silo.h5";
     options.checkpoint = dir / "silo.ckpt.h5";
+    options.overwrite = true;  // a demo remakes its figures: its own earlier run is replaced
     Analysis a;
     const std::uint64_t last = scene.steps();
     options.on_step = [&](const grbd::scene::Simulation& sim,

@@ -31,6 +31,7 @@
 #include <fstream>
 #include <iomanip>
 #include <iostream>
+#include <new>
 #include <optional>
 #include <sstream>
 #include <string>
@@ -53,9 +54,11 @@ constexpr int kExitUsage = 2;
 constexpr int kExitInput = 3;
 
 constexpr const char* kExitCodes =
-    "Exit codes: 0 done; 1 the run failed (solver diverged, file not writable); 2 bad command "
-    "line; 3 bad input (scene, checkpoint, output or FCLIB file), nothing run; 130 / 143 stopped by "
-    "SIGINT / SIGTERM after writing a checkpoint (continue with --restart).";
+    "Exit codes: 0 done; 1 the run failed (a solver diverged, a state blew up, a file could not be "
+    "written, out of memory); 2 bad command line (also: files that coincide); 3 bad input "
+    "(scene, checkpoint, output or FCLIB file; an output folder that cannot be written; an "
+    "existing result without --force), nothing run or changed; 130 / 143 stopped by SIGINT / "
+    "SIGTERM after writing a checkpoint (continue with --restart).";
 
 volatile std::sig_atomic_t g_signal = 0;
 
@@ -136,8 +139,8 @@ class Progress {
 
 int run_command(const std::string& scene_file, const std::optional<std::string>& output,
                 const std::optional<std::string>& checkpoint,
-                const std::optional<std::string>& restart, const std::optional<double>& end_time,
-                bool quiet, const std::string& progress) {
+                const std::optional<std::string>& restart, const std::optional<std::string>& end_time,
+                bool force, bool quiet, const std::string& progress) {
   grbd::scene::Scene scene;
   try {
     scene = grbd::scene::load_scene(scene_file);
@@ -146,21 +149,20 @@ int run_command(const std::string& scene_file, const std::optional<std::string>&
     return kExitInput;
   }
   if (end_time) {
-    if (!(*end_time > 0.0) || !std::isfinite(*end_time)) {
-      std::cerr << "grbd run: --end-time: expected a time > 0 s\n";
+    // The rules of the scene's key end_time: a decimal time > 0 of at most 10¹² steps.
+    try {
+      grbd::scene::set_end_time(scene, grbd::scene::parse_real(*end_time, "--end-time"),
+                                "--end-time");
+    } catch (const grbd::Error& e) {
+      std::cerr << "grbd run: " << e.what() << '\n';
       return kExitUsage;
     }
-    scene.end_time = *end_time;
   }
   grbd::io::RunOptions options;
   options.output = output ? std::filesystem::path(*output) : scene.output.file;
   options.checkpoint = checkpoint ? std::filesystem::path(*checkpoint) : scene.checkpoint.file;
   if (restart) options.restart = *restart;
-  if (options.output == options.checkpoint) {
-    std::cerr << "grbd run: the output and the checkpoint must be different files, both are "
-              << options.output << '\n';
-    return kExitUsage;
-  }
+  options.overwrite = force;
   const bool bar = progress == "bar" || (progress == "auto" && isatty(STDERR_FILENO) != 0);
   Progress display(bar, scene.steps());
   bool started = false;  // an error after the first step is a failed run, not bad input
@@ -176,6 +178,9 @@ int run_command(const std::string& scene_file, const std::optional<std::string>&
   grbd::io::RunResult result;
   try {
     result = grbd::io::run(scene, options);
+  } catch (const grbd::io::FileConflict& e) {
+    std::cerr << "grbd run: " << e.what() << '\n';
+    return kExitUsage;
   } catch (const grbd::scene::SceneError& e) {
     display.finish();
     std::cerr << "grbd run: " << e.what() << '\n';
@@ -261,12 +266,26 @@ int fclib_command(const std::vector<std::string>& inputs, double tol, int max_it
     std::cerr << "grbd fclib: " << e.what() << '\n';
     return kExitInput;
   }
+  // The CSV is written under a temporary name and renamed into place once every problem was
+  // read and solved: a refused problem leaves an earlier CSV as it was, and no input is ever
+  // the CSV (compared as files, whatever their spelling).
+  std::filesystem::path temporary;
+  if (csv) {
+    for (const auto& file : files) {
+      if (grbd::io::same_file(file, *csv)) {
+        std::cerr << "grbd fclib: --csv " << *csv << " is the problem " << file.string()
+                  << ": it would be destroyed\n";
+        return kExitUsage;
+      }
+    }
+    temporary = *csv + ".tmp";
+  }
   try {
     std::ofstream history;
     if (csv) {
-      history.open(*csv);
+      history.open(temporary);
       if (!history) {
-        std::cerr << "grbd fclib: cannot open " << *csv << " for writing\n";
+        std::cerr << "grbd fclib: cannot open " << temporary.string() << " for writing\n";
         return kExitFailed;
       }
       history << "problem,solver,k,relative_residual\n" << std::setprecision(7);
@@ -284,12 +303,25 @@ int fclib_command(const std::vector<std::string>& inputs, double tol, int max_it
                 << '\n';
       }
     });
-    if (csv && !history.flush()) {
-      std::cerr << "grbd fclib: cannot write " << *csv << '\n';
-      return kExitFailed;
+    if (csv) {
+      history.close();
+      std::error_code error;
+      if (!history) {
+        std::filesystem::remove(temporary, error);
+        std::cerr << "grbd fclib: cannot write " << temporary.string() << '\n';
+        return kExitFailed;
+      }
+      std::filesystem::rename(temporary, *csv, error);
+      if (error) {
+        std::filesystem::remove(temporary, error);
+        std::cerr << "grbd fclib: cannot move the CSV into place as " << *csv << '\n';
+        return kExitFailed;
+      }
     }
     return 0;
   } catch (const grbd::Error& e) {
+    std::error_code error;
+    if (csv) std::filesystem::remove(temporary, error);
     std::cerr << "grbd fclib: " << e.what() << '\n';
     return kExitInput;  // a file the reader refuses (the files before it were solved)
   }
@@ -373,15 +405,14 @@ int bench_command(const std::vector<std::string>& names, bool list,
 
 }  // namespace
 
-int main(int argc, char** argv) {
+int grbd_main(int argc, char** argv) {
   CLI::App app{"grbd: granular rigid body dynamics — run scenes, inspect their output"};
   app.footer(kExitCodes);
   app.require_subcommand(1);
 
   std::string scene_file;
-  std::optional<std::string> output, checkpoint, restart;
-  std::optional<double> end_time;
-  bool quiet = false;
+  std::optional<std::string> output, checkpoint, restart, end_time;
+  bool quiet = false, force = false;
   std::string progress = "auto";
   CLI::App* run = app.add_subcommand("run", "Run a scene file: HDF5 + XDMF output, checkpoints");
   run->add_option("scene", scene_file, "The scene file (TOML)")
@@ -392,7 +423,11 @@ int main(int argc, char** argv) {
                   "Where checkpoints go (default: [checkpoint] file of the scene)");
   run->add_option("-r,--restart", restart, "Continue from this checkpoint")
       ->check(CLI::ExistingFile);
-  run->add_option("--end-time", end_time, "Run to this time [s] instead of the scene's end_time");
+  run->add_option("--end-time", end_time,
+                  "Run to this time [s] instead of the scene's end_time (the same rules: a "
+                  "decimal number > 0, at most 10^12 steps)");
+  run->add_flag("-f,--force", force,
+                "Replace an existing output, XDMF and checkpoint (a fresh run refuses to)");
   run->add_flag("-q,--quiet", quiet, "No progress and no summary; errors only");
   run->add_option("--progress", progress,
                   "auto (a bar on a terminal, else a line every 10 s), bar, lines")
@@ -459,11 +494,24 @@ int main(int argc, char** argv) {
     const int code = app.exit(e);
     return code == 0 ? 0 : kExitUsage;
   }
-  if (run->parsed())
-    return run_command(scene_file, output, checkpoint, restart, end_time, quiet, progress);
-  if (validate->parsed()) return validate_command(validate_file);
-  if (info->parsed()) return info_command(info_file);
-  if (fclib->parsed()) return fclib_command(fclib_inputs, fclib_tol, fclib_max_iterations, fclib_csv);
-  if (bench->parsed()) return bench_command(bench_names, bench_list, bench->remaining());
+  // Memory that runs out is an error with a message and an exit code, never an abort.
+  try {
+    if (run->parsed())
+      return run_command(scene_file, output, checkpoint, restart, end_time, force, quiet, progress);
+    if (validate->parsed()) return validate_command(validate_file);
+    if (info->parsed()) return info_command(info_file);
+    if (fclib->parsed())
+      return fclib_command(fclib_inputs, fclib_tol, fclib_max_iterations, fclib_csv);
+    if (bench->parsed()) return bench_command(bench_names, bench_list, bench->remaining());
+  } catch (const std::bad_alloc&) {
+    std::cerr << "grbd: out of memory: the scene or file asks for more than this machine (or "
+                 "its limits) can give\n";
+    return kExitFailed;
+  }
   return kExitUsage;
+}
+
+int main(int argc, char** argv) {
+  const grbd::io::Hdf5Cleanup hdf5;  // first: see io::Hdf5Cleanup
+  return grbd_main(argc, argv);
 }

@@ -265,7 +265,9 @@ TEST(ObjReader, RejectsEveryBrokenRuleWithLineAndToken) {
       {"v 0 0 0\n\n  V 1 0 0\n", 3, "'V'"},                        // keywords are lower case
       {"v 0 0 0\nv 1 0 0 \\\n 0\n", 2, "'\\'"},                    // no line continuation
       {"v 0 0 0\nv 1 0\x01 0\n", 2, "'0\\x01'"},                   // control character
-      {"v 0 0 0\n\xff\xfe v\n", 2, "'\\xff\\xfe'"},                // binary bytes
+      // Binary bytes (or any keyword that is not a short word) are not quoted: a file that is
+      // not OBJ has nothing of its text repeated in the message.
+      {"v 0 0 0\n\xff\xfe v\n", 2, "a line that is not OBJ (the file is not an OBJ file)"},
       {std::string("v 0 0 0\nv 0\0 0 0\n", 17), 2, "'0\\x00'"},    // a NUL byte
   };
   const TempDir dir;

@@ -274,4 +274,37 @@ TEST(SceneFile, ClosestKeyIsTheNearestWithinHalfTheLength) {
   EXPECT_EQ(grbd::scene::closest_key("cout", {"jitter", "spacing", "count"}), "count");
 }
 
+// Costs that grow linearly: 10⁵ static objects (each id checked against the others by a hash,
+// not by a scan: a quadratic check took 45 s here) and 1024 materials (the pair table grows by
+// doubling). The test's time limit is what fails when they become quadratic again.
+TEST(SceneFile, ManyStaticObjectsAndMaterialsCostLinearTime) {
+  std::ostringstream text;
+  text << "[simulation]\ndt = 1e-3\nend_time = 0.01\n\n[[material]]\nname = \"glass\"\n\n"
+          "[default_contact]\nmu = 0.5\n";
+  constexpr int kStatics = 100000;
+  for (int k = 0; k < kStatics; ++k) {
+    text << "[[static]]\nshape = \"sphere\"\nradius = 0.001\nposition = [" << k * 0.01
+         << ", 5.0, 5.0]\nmaterial = \"glass\"\n";
+  }
+  for (int k = 1; k < 1024; ++k) text << "[[material]]\nname = \"m" << k << "\"\n";
+  text << "[[bodies]]\nradius = 0.01\ndensity = 2500.0\nmaterial = \"glass\"\n"
+          "positions = [[0.0, 0.0, 0.05]]\n";
+  const Scene scene = parse_scene(text.str(), "many.toml");
+  grbd::scene::Simulation sim(scene);
+  EXPECT_EQ(sim.statics().size(), static_cast<std::size_t>(kStatics));
+  EXPECT_EQ(sim.materials().size(), 1024U);
+  EXPECT_EQ(*sim.materials().find("m1023"), 1023U);
+  // The hash still refuses an id used twice, and the table a 1025th material, naming the file.
+  grbd::timestep::StaticGeometry statics = sim.statics();
+  grbd::timestep::StaticObject again = sim.statics().objects()[54321];
+  EXPECT_THROW(statics.add(again), grbd::InvalidArgument);
+  try {
+    parse_scene(text.str() + "[[material]]\nname = \"one too many\"\n", "many.toml");
+    ADD_FAILURE() << "a 1025th material was accepted";
+  } catch (const SceneError& e) {
+    EXPECT_NE(std::string(e.what()).find("many.toml:"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("at most 1024 materials"), std::string::npos);
+  }
+}
+
 }  // namespace

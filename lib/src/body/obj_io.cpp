@@ -6,6 +6,7 @@
 /// a mesh silently read wrong is worse than no mesh.
 
 #include <algorithm>
+#include <cctype>
 #include <array>
 #include <cerrno>
 #include <charconv>
@@ -161,10 +162,16 @@ class ObjParser {
       // Texture coordinates, normals, names, groups, smoothing and materials carry nothing that
       // the mass properties need.
     } else {
-      fail(
-          "a statement 'v', 'f', 'vt', 'vn', 'vp', 'o', 'g', 's', 'usemtl', 'mtllib' or a "
-          "comment",
-          keyword);
+      // A keyword is quoted only when it looks like one (a short word): a file that is not OBJ
+      // at all (a password file named by mistake or by a scene from elsewhere) has nothing of
+      // its text repeated in the message.
+      const bool word = keyword.size() <= 16 && std::all_of(keyword.begin(), keyword.end(), [](char c) {
+                          return std::isalpha(static_cast<unsigned char>(c)) || c == '_';
+                        });
+      fail("a statement 'v', 'f', 'vt', 'vn', 'vp', 'o', 'g', 's', 'usemtl', 'mtllib' or a "
+           "comment",
+           word ? keyword : std::string_view("a line that is not OBJ (the file is not an OBJ file)"),
+           word);
     }
   }
 

@@ -5,8 +5,13 @@
 #include <fcntl.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
+
+#include "grbd/core/checks.hpp"
+#include "grbd/core/hash.hpp"
 
 #include "io/h5util.hpp"
 
@@ -26,10 +31,74 @@ void sync_path(const std::filesystem::path& path, int flags) {
   if (status != 0) throw IoError(path.string() + ": cannot flush it to the disk (fsync)");
 }
 
+// A 64-bit checksum of everything a checkpoint holds, word by word through SplitMix64's
+// finaliser: a flipped bit anywhere in the values changes it (not a defence against forgery).
+class Checksum {
+ public:
+  void add(std::uint64_t word) { h_ = mix64(h_ ^ word ^ (++k_ * 0x9e3779b97f4a7c15ULL)); }
+  void add(double x) {
+    std::uint64_t word = 0;
+    std::memcpy(&word, &x, sizeof(x));
+    add(word);
+  }
+  void add(const std::string& text) {
+    add(static_cast<std::uint64_t>(text.size()));
+    for (std::size_t i = 0; i < text.size(); i += 8) {
+      std::uint64_t word = 0;
+      std::memcpy(&word, text.data() + i, std::min<std::size_t>(8, text.size() - i));
+      add(word);
+    }
+  }
+  std::uint64_t value() const { return h_; }
+
+ private:
+  std::uint64_t h_ = 0x6772626463686b70ULL;  // "grbdchkp"
+  std::uint64_t k_ = 0;
+};
+
+std::uint64_t checksum(const Checkpoint& c) {
+  const scene::SimulationState& s = c.state;
+  Checksum sum;
+  sum.add(c.scene_text);
+  sum.add(s.t);
+  for (std::uint64_t x : {s.steps, s.next_id, s.removed, c.output.records, c.output.steps,
+                          c.output.bodies, static_cast<std::uint64_t>(s.bodies.size()),
+                          static_cast<std::uint64_t>(s.warm_keys.size()),
+                          static_cast<std::uint64_t>(s.generators.size())}) {
+    sum.add(x);
+  }
+  sum.add(s.removed_mass);
+  for (std::size_t i = 0; i < s.bodies.size(); ++i) {
+    const h5::BodyRow row = h5::body_row(s.bodies[i]);
+    sum.add(row.id);
+    sum.add(std::uint64_t{row.shape} | std::uint64_t{row.fixed} << 8 |
+            std::uint64_t{row.material} << 16);
+    for (double x : {row.radius, row.half_extents[0], row.half_extents[1], row.half_extents[2],
+                     row.half_length, row.mass, row.K_Theta[0], row.K_Theta[1], row.K_Theta[2]}) {
+      sum.add(x);
+    }
+    for (int d = 0; d < 7; ++d) sum.add(s.states[i].q[d]);
+    for (int d = 0; d < 6; ++d) sum.add(s.states[i].u[d]);
+  }
+  for (std::size_t k = 0; k < s.warm_keys.size(); ++k) {
+    const timestep::ContactKey& key = s.warm_keys[k];
+    for (std::uint64_t x : {key.a, key.b, std::uint64_t{key.feature_a}, std::uint64_t{key.feature_b}})
+      sum.add(x);
+    for (int d = 0; d < 3; ++d) sum.add(s.warm_lambda[k][d]);
+  }
+  for (const scene::GeneratorState& g : s.generators) {
+    sum.add(g.random);
+    sum.add(g.created);
+  }
+  return sum.value();
+}
+
 }  // namespace
 
-void write_checkpoint(const std::filesystem::path& path, const Checkpoint& checkpoint) {
-  const std::filesystem::path temporary = path.string() + ".tmp";
+namespace {
+
+// Writes the checkpoint into `temporary`, flushed to the disk.
+void write_temporary(const std::filesystem::path& temporary, const Checkpoint& checkpoint) {
   const std::string file = temporary.string();
   const scene::SimulationState& s = checkpoint.state;
   {
@@ -49,6 +118,7 @@ void write_checkpoint(const std::filesystem::path& path, const Checkpoint& check
     h5::write_attribute(root, "output_records", checkpoint.output.records, file);
     h5::write_attribute(root, "output_steps", checkpoint.output.steps, file);
     h5::write_attribute(root, "output_bodies", checkpoint.output.bodies, file);
+    h5::write_attribute(root, "checksum", checksum(checkpoint), file);
 
     const std::size_t n = s.bodies.size();
     std::vector<h5::BodyRow> rows(n);
@@ -89,6 +159,19 @@ void write_checkpoint(const std::filesystem::path& path, const Checkpoint& check
     if (!handle.close()) h5::fail(file, "cannot close the checkpoint");
   }
   sync_path(temporary, O_RDONLY);
+}
+
+}  // namespace
+
+void write_checkpoint(const std::filesystem::path& path, const Checkpoint& checkpoint) {
+  const std::filesystem::path temporary = path.string() + ".tmp";
+  try {
+    write_temporary(temporary, checkpoint);
+  } catch (const Error&) {
+    std::error_code ignored;  // a partial temporary is of no use; the previous checkpoint stays
+    std::filesystem::remove(temporary, ignored);
+    throw;
+  }
   std::error_code error;
   std::filesystem::rename(temporary, path, error);
   if (error) {
@@ -99,12 +182,60 @@ void write_checkpoint(const std::filesystem::path& path, const Checkpoint& check
   sync_path(folder, O_RDONLY | O_DIRECTORY);
 }
 
+namespace {
+
+// What a checkpoint can be checked against without its scene: finite values, counters in range.
+void require_consistent(const Checkpoint& c, const std::string& file) {
+  const scene::SimulationState& s = c.state;
+  const auto refuse = [&](const std::string& what) { h5::fail(file, what); };
+  if (s.next_id >= timestep::kStaticTag) {
+    refuse("attribute next_id: expected an id below 2^63, found " + std::to_string(s.next_id));
+  }
+  if (s.removed > s.next_id) {
+    refuse("attribute removed: " + std::to_string(s.removed) +
+           " bodies removed, more than the " + std::to_string(s.next_id) + " created (next_id)");
+  }
+  if (!std::isfinite(s.removed_mass) || s.removed_mass < 0.0) {
+    refuse("attribute removed_mass: expected a finite mass ≥ 0, found " +
+           format_number(s.removed_mass));
+  }
+  if (s.steps > scene::kMaxSteps) {
+    refuse("attribute steps: expected at most 10¹², found " + std::to_string(s.steps));
+  }
+  if (c.output.steps > s.steps || c.output.records > s.steps + 1 ||
+      c.output.bodies > s.next_id) {
+    refuse("attributes output_records, output_steps, output_bodies: expected at most steps + 1, "
+           "steps and next_id, found " + std::to_string(c.output.records) + ", " +
+           std::to_string(c.output.steps) + ", " + std::to_string(c.output.bodies));
+  }
+  for (std::size_t i = 0; i < s.states.size(); ++i) {
+    if (!s.states[i].q.allFinite() || !s.states[i].u.allFinite()) {
+      refuse("dataset states, row " + std::to_string(i) + " (body " +
+             std::to_string(s.bodies[i].id) + "): not finite");
+    }
+  }
+  for (std::size_t k = 0; k < s.warm_lambda.size(); ++k) {
+    if (!(s.warm_lambda[k][0] >= 0.0)) {
+      refuse("dataset warm_start_lambda, row " + std::to_string(k) +
+             ": expected a normal percussion lambda_N ≥ 0, found " +
+             format_number(s.warm_lambda[k][0]));
+    }
+  }
+  for (std::size_t g = 0; g < s.generators.size(); ++g) {
+    if (s.generators[g].created > s.next_id) {
+      refuse("dataset generators, row " + std::to_string(g) + ": " +
+             std::to_string(s.generators[g].created) + " bodies created, more than next_id");
+    }
+  }
+}
+
+}  // namespace
+
 Checkpoint read_checkpoint(const std::filesystem::path& path) {
   std::lock_guard lock(hdf5::mutex());
   hdf5::QuietErrors quiet;
   const std::string file = path.string();
-  std::error_code error;
-  if (!std::filesystem::is_regular_file(path, error)) h5::fail(file, "no such checkpoint file");
+  h5::require_regular_file(path, "checkpoint file");
   if (H5Fis_hdf5(file.c_str()) <= 0) h5::fail(file, "is not an HDF5 file");
   Handle handle = check(H5Fopen(file.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), H5Fclose, file,
                         "cannot open the checkpoint (it may be damaged)");
@@ -114,8 +245,8 @@ Checkpoint read_checkpoint(const std::filesystem::path& path) {
     h5::fail(file, "is not a grbd checkpoint (attribute format is not \"grbd checkpoint\")");
   }
   const std::uint64_t version = h5::read_uint(root, "format_version", file);
-  if (version != kCheckpointFormatVersion) {
-    h5::fail(file, "format_version " + std::to_string(version) + ", this grbd reads version " +
+  if (version != kCheckpointFormatVersion && version != 1) {
+    h5::fail(file, "format_version " + std::to_string(version) + ", this grbd reads versions 1 and " +
                        std::to_string(kCheckpointFormatVersion));
   }
   Checkpoint c;
@@ -170,6 +301,11 @@ Checkpoint read_checkpoint(const std::filesystem::path& path) {
   s.generators.resize(g);
   for (std::uint64_t k = 0; k < g; ++k)
     s.generators[k] = {generators[2 * k], generators[2 * k + 1]};
+  // Version 2 carries a checksum of every value: damage is named as damage.
+  if (version >= 2 && h5::read_uint(root, "checksum", file) != checksum(c)) {
+    h5::fail(file, "is damaged: the checksum of its values does not match the one written with it");
+  }
+  require_consistent(c, file);
   return c;
 }
 

@@ -2,7 +2,14 @@
 
 #include "io/h5util.hpp"
 
+#include <fcntl.h>
+#include <sys/file.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <cerrno>
 #include <cstddef>
+#include <cstring>
 #include <limits>
 
 namespace grbd::io::h5 {
@@ -44,6 +51,30 @@ scene::BodyConstants body_constants(const BodyRow& row) {
     body.inertia.K_Theta[d] = row.K_Theta[d];
   }
   return body;
+}
+
+bool same_constants(const BodyRow& a, const BodyRow& b) {
+  const auto same = [](const double* x, const double* y, int n) {
+    return std::memcmp(x, y, static_cast<std::size_t>(n) * sizeof(double)) == 0;
+  };
+  return a.id == b.id && a.shape == b.shape && a.fixed == b.fixed && a.material == b.material &&
+         same(&a.radius, &b.radius, 1) && same(a.half_extents, b.half_extents, 3) &&
+         same(&a.half_length, &b.half_length, 1) && same(&a.mass, &b.mass, 1) &&
+         same(a.K_Theta, b.K_Theta, 3);
+}
+
+void require_regular_file(const std::filesystem::path& path, const std::string& what) {
+  std::error_code error;
+  const auto status = std::filesystem::status(path, error);
+  if (!std::filesystem::exists(status)) {
+    if (error && error != std::errc::no_such_file_or_directory) {
+      fail(path.string(), "cannot examine the " + what + ": " + error.message());
+    }
+    fail(path.string(), "no such " + what);
+  }
+  if (!std::filesystem::is_regular_file(status)) {
+    fail(path.string(), "is not a regular file, as a " + what + " is");
+  }
 }
 
 Handle body_row_type() {
@@ -279,5 +310,46 @@ template std::uint64_t read_array<BodyRow>(hid_t, const char*, hid_t, std::int64
                                            std::vector<BodyRow>&, const std::string&);
 template std::uint64_t read_array<StepRow>(hid_t, const char*, hid_t, std::int64_t, std::uint64_t,
                                            std::vector<StepRow>&, const std::string&);
+
+FileLock::FileLock(const std::filesystem::path& path, bool create) {
+  const std::string file = path.string();
+  // O_NONBLOCK: a FIFO must not block the open; it is refused below, as any file that is not
+  // a regular one.
+  fd_ = ::open(file.c_str(), O_RDWR | O_CLOEXEC | O_NONBLOCK | (create ? O_CREAT : 0), 0666);
+  if (fd_ < 0) throw IoError(file + ": cannot open the output file: " + std::strerror(errno));
+  struct stat status {};
+  if (::fstat(fd_, &status) != 0 || !S_ISREG(status.st_mode)) {
+    ::close(fd_);
+    fd_ = -1;
+    throw IoError(file + ": is not a regular file, as a grbd output file is");
+  }
+  if (::flock(fd_, LOCK_EX | LOCK_NB) != 0) {
+    const int error = errno;
+    ::close(fd_);
+    fd_ = -1;
+    throw IoError(file + (error == EWOULDBLOCK
+                              ? ": is in use: another grbd run writes it, or another program has "
+                                "it open (HDF5's lock); nothing was changed"
+                              : ": cannot lock the file: " + std::string(std::strerror(error))));
+  }
+}
+
+FileLock::~FileLock() {
+  if (fd_ >= 0) ::close(fd_);  // releases the lock
+}
+
+bool locked_elsewhere(const std::filesystem::path& path) {
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd < 0) return false;
+  const bool held = ::flock(fd, LOCK_EX | LOCK_NB) != 0 && errno == EWOULDBLOCK;
+  ::close(fd);  // releases the probe's lock, if it got it
+  return held;
+}
+
+Handle locked_access(const std::string& file) {
+  Handle access = check(H5Pcreate(H5P_FILE_ACCESS), H5Pclose, file, "cannot create a property list");
+  check(H5Pset_file_locking(access.get(), false, true), file, "cannot set the file locking");
+  return access;
+}
 
 }  // namespace grbd::io::h5

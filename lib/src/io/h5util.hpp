@@ -5,6 +5,7 @@
 #include <hdf5.h>
 
 #include <cstdint>
+#include <filesystem>
 #include <string>
 #include <vector>
 
@@ -48,6 +49,11 @@ struct BodyRow {
 /// The row of a body's constants, and the constants of a row (as written).
 BodyRow body_row(const scene::BodyConstants& body);
 scene::BodyConstants body_constants(const BodyRow& row);
+/// Whether two rows hold the same body (every field equal, bit for bit for the numbers).
+bool same_constants(const BodyRow& a, const BodyRow& b);
+/// Throws IoError naming `path` ("no such <what>", "not a regular file") unless it is a regular
+/// file (a FIFO or a device would block or never end).
+void require_regular_file(const std::filesystem::path& path, const std::string& what);
 
 /// One row of /steps.
 struct StepRow {
@@ -103,5 +109,30 @@ void write_array(hid_t location, const char* name, hid_t file_type, hid_t memory
 template <class T>
 std::uint64_t read_array(hid_t location, const char* name, hid_t memory_type, std::int64_t rows,
                          std::uint64_t cols, std::vector<T>& data, const std::string& file);
+
+/// grbd's claim on an output file while it writes it: flock(LOCK_EX) on a descriptor of its own,
+/// taken before HDF5 opens (and a new output truncates) the file and held until it is closed.
+/// It is the lock HDF5 itself takes (flock), so a second grbd run, and any HDF5 program that has
+/// the file open, are refused before anything is touched; HDF5's own lock is switched off for
+/// the files opened with locked_access() under it.
+class FileLock {
+ public:
+  /// Locks `path`, creating an empty file when `create` and there is none. Throws IoError naming
+  /// the file when it cannot be opened or another process holds it.
+  FileLock(const std::filesystem::path& path, bool create);
+  ~FileLock();
+  FileLock(const FileLock&) = delete;
+  FileLock& operator=(const FileLock&) = delete;
+
+ private:
+  int fd_ = -1;
+};
+
+/// Whether another process holds `path` open under a lock (a grbd run, or an HDF5 program): a
+/// probe that takes and releases the lock; false when the file does not exist.
+bool locked_elsewhere(const std::filesystem::path& path);
+
+/// File access properties for a file held by a FileLock: HDF5's own lock off.
+Handle locked_access(const std::string& file);
 
 }  // namespace grbd::io::h5

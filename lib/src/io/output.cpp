@@ -76,12 +76,11 @@ Handle open_group(hid_t location, const char* name, const std::string& file) {
 }
 
 // Opens an output file, checking that it is one (IoError naming it when not).
-Handle open_output(const std::filesystem::path& path, unsigned mode) {
+Handle open_output(const std::filesystem::path& path, unsigned mode, hid_t access = H5P_DEFAULT) {
   const std::string file = path.string();
-  std::error_code error;
-  if (!std::filesystem::is_regular_file(path, error)) h5::fail(file, "no such file");
+  h5::require_regular_file(path, "grbd output file");
   if (H5Fis_hdf5(file.c_str()) <= 0) h5::fail(file, "is not an HDF5 file");
-  Handle handle = check(H5Fopen(file.c_str(), mode, H5P_DEFAULT), H5Fclose, file,
+  Handle handle = check(H5Fopen(file.c_str(), mode, access), H5Fclose, file,
                         "cannot open the file (it may be damaged)");
   if (H5Aexists(handle.get(), "format") <= 0 ||
       h5::read_string(handle.get(), "format", file) != "grbd output") {
@@ -95,9 +94,43 @@ Handle open_output(const std::filesystem::path& path, unsigned mode) {
   return handle;
 }
 
+// Every body of the checkpoint must have its row, the same constants, among the first `rows`
+// rows of /bodies: else the output belongs to another run.
+void check_bodies(hid_t root, const std::string& file, std::uint64_t rows,
+                  std::span<const scene::BodyConstants> bodies) {
+  std::vector<h5::BodyRow> table;
+  Handle type = h5::body_row_type();
+  h5::read_array(root, "bodies", type.get(), -1, 0, table, file);
+  table.resize(std::min<std::size_t>(table.size(), rows));
+  std::sort(table.begin(), table.end(),
+            [](const h5::BodyRow& a, const h5::BodyRow& b) { return a.id < b.id; });
+  for (const scene::BodyConstants& body : bodies) {
+    const h5::BodyRow expected = h5::body_row(body);
+    const auto it = std::lower_bound(
+        table.begin(), table.end(), body.id,
+        [](const h5::BodyRow& row, std::uint64_t id) { return row.id < id; });
+    if (it == table.end() || it->id != body.id ||
+        !h5::same_constants(*it, expected)) {
+      h5::fail(file, "belongs to another run: the body with id " + std::to_string(body.id) +
+                         " of the checkpoint is " +
+                         (it == table.end() || it->id != body.id ? "not in its table /bodies"
+                                                                 : "another body in /bodies") +
+                         "; nothing was changed (continue into a new output with -o)");
+    }
+  }
+}
+
 }  // namespace
 
+std::size_t first_different_line(std::string_view a, std::string_view b) {
+  std::size_t line = 1;
+  const std::size_t n = std::min(a.size(), b.size());
+  for (std::size_t i = 0; i < n && a[i] == b[i]; ++i) line += a[i] == '\n' ? 1 : 0;
+  return line;
+}
+
 struct OutputFile::Impl {
+  std::unique_ptr<h5::FileLock> lock;  // first: released after every handle is closed
   std::filesystem::path path;
   std::string file;
   bool float32 = false;
@@ -138,8 +171,11 @@ OutputFile::OutputFile(const std::filesystem::path& path, const scene::Scene& sc
   o.path = path;
   o.file = path.string();
   o.float32 = scene.output.float32;
-  o.handle = check(H5Fcreate(o.file.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT), H5Fclose,
-                   o.file, "cannot create the output file");
+  // The lock before the truncation: a file that another run writes is refused untouched.
+  o.lock = std::make_unique<h5::FileLock>(path, true);
+  o.handle = check(H5Fcreate(o.file.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT,
+                             h5::locked_access(o.file).get()),
+                   H5Fclose, o.file, "cannot create the output file");
   const hid_t root = o.handle.get();
   h5::write_attribute(root, "format", std::string("grbd output"), o.file);
   h5::write_attribute(root, "format_version", kOutputFormatVersion, o.file);
@@ -170,7 +206,7 @@ OutputFile::OutputFile(const std::filesystem::path& path, const scene::Scene& sc
 }
 
 OutputFile::OutputFile(const std::filesystem::path& path, const scene::Scene& scene,
-                       const OutputPosition& at)
+                       const OutputPosition& at, const RunIdentity& run)
 {
   std::lock_guard lock(hdf5::mutex());
   hdf5::QuietErrors quiet;
@@ -178,8 +214,15 @@ OutputFile::OutputFile(const std::filesystem::path& path, const scene::Scene& sc
   Impl& o = *impl_;
   o.path = path;
   o.file = path.string();
-  o.handle = open_output(path, H5F_ACC_RDWR);
+  o.lock = std::make_unique<h5::FileLock>(path, false);
+  o.handle = open_output(path, H5F_ACC_RDWR, h5::locked_access(o.file).get());
   const hid_t root = o.handle.get();
+  // Nothing is cut back before the file is known to be the output of the run that continues.
+  if (const std::string text = h5::read_string(root, "scene", o.file); text != run.scene_text) {
+    h5::fail(o.file, "belongs to another run: its scene differs from the checkpoint's at line " +
+                         std::to_string(first_different_line(text, run.scene_text)) +
+                         "; nothing was changed (continue into a new output with -o)");
+  }
   o.float32 = h5::read_string(root, "precision", o.file) == "float";
   if (o.float32 != scene.output.float32) {
     h5::fail(o.file, "was written in " + std::string(o.float32 ? "float" : "double") +
@@ -199,6 +242,7 @@ OutputFile::OutputFile(const std::filesystem::path& path, const scene::Scene& sc
                          " records, " + std::to_string(at.steps) + " steps, " +
                          std::to_string(at.bodies) + " bodies): it is not this run's output");
   }
+  check_bodies(root, o.file, at.bodies, run.bodies);
   // Drop what follows the checkpoint: it is written again.
   for (std::uint64_t k = at.records;; ++k) {
     const std::string name = record_name(k);
@@ -370,6 +414,7 @@ void OutputFile::close(scene::Simulation& simulation) {
     h->close();
   }
   if (!o.handle.close()) h5::fail(o.file, "cannot close the output file");
+  o.lock.reset();  // closed: other readers and writers may have it
   o.xdmf.close();
   if (o.xdmf.fail()) throw IoError(xdmf_path(o.path).string() + ": cannot close the XDMF file");
 }
@@ -453,6 +498,16 @@ void OutputFile::append_xdmf() {
   o.xdmf.flush();
   if (!o.xdmf) throw IoError(xdmf_path(o.path).string() + ": cannot append to the XDMF file");
   o.xdmf_footer += static_cast<std::streamoff>(text.size() - kXdmfFooter.size());
+}
+
+Hdf5Cleanup::Hdf5Cleanup() {
+  std::lock_guard lock(hdf5::mutex());
+  H5dont_atexit();
+}
+
+Hdf5Cleanup::~Hdf5Cleanup() {
+  std::lock_guard lock(hdf5::mutex());
+  if (H5Fget_obj_count(H5F_OBJ_ALL, H5F_OBJ_FILE) == 0) H5close();
 }
 
 OutputSummary read_summary(const std::filesystem::path& path) {

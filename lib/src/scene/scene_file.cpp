@@ -7,6 +7,7 @@
 
 #include <toml++/toml.h>
 #include <algorithm>
+#include <charconv>
 #include <cmath>
 #include <fstream>
 #include <limits>
@@ -19,6 +20,8 @@
 #include "grbd/kinematics/exponential.hpp"
 #include "grbd/kinematics/rotation.hpp"
 #include "grbd/scene/scene.hpp"
+#include "grbd/timestep/materials.hpp"
+#include "grbd/core/checks.hpp"
 
 namespace grbd::scene {
 
@@ -38,6 +41,33 @@ std::string_view generator_name(GeneratorKind kind) {
 
 std::uint64_t Scene::steps() const {
   return static_cast<std::uint64_t>(std::llround(end_time / settings.dt));
+}
+
+void set_end_time(Scene& scene, double end_time, std::string_view source) {
+  if (!(end_time > 0.0) || !std::isfinite(end_time)) {
+    throw SceneError(std::string(source) + ": expected a time > 0 s, found " +
+                     format_number(end_time));
+  }
+  if (end_time / scene.settings.dt > static_cast<double>(kMaxSteps)) {
+    throw SceneError(std::string(source) + ": expected at most 10¹² steps of dt = " +
+                     format_number(scene.settings.dt) + " s, found " + format_number(end_time) +
+                     " s");
+  }
+  scene.end_time = end_time;
+}
+
+double parse_real(std::string_view text, std::string_view source) {
+  double value = 0.0;
+  const char* first = text.data();
+  const char* last = first + text.size();
+  // from_chars takes no leading '+' and, in the general format, no hexadecimal; "inf" and "nan"
+  // it does take, and they are refused below.
+  const auto [end, error] = std::from_chars(first, last, value, std::chars_format::general);
+  if (text.empty() || error != std::errc() || end != last || !std::isfinite(value)) {
+    throw SceneError(std::string(source) + ": expected a decimal number such as 0.5 or 2e-3, found \"" +
+                     std::string(text) + "\"");
+  }
+  return value;
 }
 
 std::string closest_key(std::string_view key, const std::vector<std::string_view>& known) {
@@ -232,6 +262,15 @@ class TableReader {
     auto value = string_opt(key);
     if (!value) missing(key, what);
     return *value;
+  }
+  // A file name: a non-empty string without NUL (the system would cut the name there and open
+  // another file).
+  std::optional<std::string> file_name_opt(std::string_view key) {
+    auto value = string_opt(key);
+    if (value && value->find('\0') != std::string::npos) {
+      fail(*get(key), key, "a file name without NUL characters");
+    }
+    return value;
   }
 
   // One of `choices`; returns its index (`fallback` when the key is absent).
@@ -447,6 +486,10 @@ void read_simulation(TableReader& t, Scene& scene) {
   scene.settings.dt = t.real_required("dt", kPositive);
   scene.end_time = t.real_required("end_time", kPositive);
   scene.settings.I_g = t.vector("gravity", scene.settings.I_g);
+  if (!std::isfinite(scene.settings.I_g.squaredNorm())) {  // the energies would overflow at once
+    t.fail(*t.table().get("gravity"), "gravity",
+           "a vector of magnitude below 10¹⁵⁴ m/s² (its square must be finite)");
+  }
   scene.seed =
       static_cast<std::uint64_t>(t.integer("seed", 1, 0, std::numeric_limits<std::int64_t>::max()));
   if (const toml::node* node = t.get("domain")) {
@@ -455,7 +498,7 @@ void read_simulation(TableReader& t, Scene& scene) {
     scene.domain.box = read_region(t, "domain");
   }
   const double steps = scene.end_time / scene.settings.dt;
-  if (steps > 1e12) {
+  if (steps > static_cast<double>(kMaxSteps)) {
     t.fail(*t.table().get("end_time"), "end_time", "at most 10¹² steps of dt");
   }
   t.finish();
@@ -534,7 +577,9 @@ void read_static(TableReader& t, Scene& scene, const std::filesystem::path& fold
       s.shape = collision::Sphere{t.real_required("radius", kPositive)};
       break;
     default: {
-      const std::string file = t.string_required("file", "the path of an OBJ file");
+      const std::optional<std::string> name = t.file_name_opt("file");
+      if (!name) t.missing("file", "the path of an OBJ file");
+      const std::string file = *name;
       const double scale = t.real("scale", 1.0, kPositive);
       s.mesh_file = folder / file;
       body::TriangleMesh mesh;
@@ -653,7 +698,7 @@ void read_group(TableReader& t, Scene& scene, std::size_t index) {
 }
 
 void read_output(TableReader& t, Scene& scene) {
-  if (auto file = t.string_opt("file")) scene.output.file = *file;
+  if (auto file = t.file_name_opt("file")) scene.output.file = *file;
   scene.output.every =
       static_cast<std::uint64_t>(t.integer("every", static_cast<std::int64_t>(scene.output.every),
                                            0, std::numeric_limits<std::int64_t>::max()));
@@ -662,7 +707,7 @@ void read_output(TableReader& t, Scene& scene) {
 }
 
 void read_checkpoint(TableReader& t, Scene& scene) {
-  if (auto file = t.string_opt("file")) scene.checkpoint.file = *file;
+  if (auto file = t.file_name_opt("file")) scene.checkpoint.file = *file;
   scene.checkpoint.every = static_cast<std::uint64_t>(
       t.integer("every", 0, 0, std::numeric_limits<std::int64_t>::max()));
   t.finish();
@@ -703,6 +748,12 @@ Scene parse_scene(std::string_view text, const std::filesystem::path& file) {
   if (materials == nullptr) top.missing("material", "at least one [[material]] with a name");
   for (std::size_t k = 0; k < materials->size(); ++k) {
     TableReader t(*materials->get(k)->as_table(), indexed("material", k), name);
+    if (k == timestep::MaterialTable::kMaxMaterials) {
+      t.fail_at(t.table().source(), "name",
+                "at most " + std::to_string(timestep::MaterialTable::kMaxMaterials) +
+                    " materials (the table of laws holds every pair)",
+                std::to_string(materials->size()) + " materials");
+    }
     std::string material = t.string_required("name", "the material's name");
     if (std::find(scene.materials.begin(), scene.materials.end(), material) !=
         scene.materials.end()) {
@@ -798,12 +849,31 @@ Scene parse_scene(std::string_view text, const std::filesystem::path& file) {
 }
 
 Scene load_scene(const std::filesystem::path& file) {
+  // A FIFO would block and a device never end: only a regular file, of bounded size, is read.
+  std::error_code error;
+  const auto status = std::filesystem::status(file, error);
+  if (!std::filesystem::exists(status)) throw SceneError(file.string() + ": no such scene file");
+  if (!std::filesystem::is_regular_file(status)) {
+    throw SceneError(file.string() + ": is not a regular file (a scene file is one)");
+  }
+  const std::uintmax_t size = std::filesystem::file_size(file, error);
+  if (!error && size > kMaxSceneBytes) {
+    throw SceneError(file.string() + ": expected a scene file of at most " +
+                     std::to_string(kMaxSceneBytes >> 20) + " MiB, found " +
+                     std::to_string(size >> 20) + " MiB");
+  }
   std::ifstream in(file, std::ios::binary);
   if (!in) throw SceneError(file.string() + ": cannot open the scene file for reading");
-  std::ostringstream text;
-  text << in.rdbuf();
+  // One byte more than expected: a file that grew while being read is noticed.
+  std::string text(static_cast<std::size_t>(error ? kMaxSceneBytes : size) + 1, '\0');
+  in.read(text.data(), static_cast<std::streamsize>(text.size()));
   if (in.bad()) throw SceneError(file.string() + ": cannot read the scene file");
-  return parse_scene(text.str(), file);
+  text.resize(static_cast<std::size_t>(in.gcount()));
+  if (text.size() > kMaxSceneBytes || (!error && text.size() > size)) {
+    throw SceneError(file.string() + ": expected a scene file of at most " +
+                     std::to_string(kMaxSceneBytes >> 20) + " MiB");
+  }
+  return parse_scene(text, file);
 }
 
 std::string summary(const Scene& scene) {

@@ -2,8 +2,12 @@
 
 #include "grbd/scene/simulation.hpp"
 
+#include <sys/resource.h>
+#include <unistd.h>
+
 #include <algorithm>
 #include <cmath>
+#include <fstream>
 #include <limits>
 #include <memory>
 #include <sstream>
@@ -12,6 +16,7 @@
 #include "grbd/body/mass_properties.hpp"
 #include "grbd/collision/narrow_phase.hpp"
 #include "grbd/collision/world.hpp"
+#include "grbd/core/checks.hpp"
 #include "grbd/kinematics/rigid_motion.hpp"
 #include "grbd/kinematics/rotation.hpp"
 
@@ -145,7 +150,78 @@ body::State initial_state(const BodyGroup& group, Random& random, const Vector3&
 
 constexpr std::uint64_t kMaxBodies = 100'000'000;
 
+// The memory this process can still take [bytes]: the smaller of what the system has available
+// (MemAvailable + SwapFree of /proc/meminfo) and what the address-space limit leaves (RLIMIT_AS
+// less the current size); "unlimited" where neither is known.
+double available_memory() {
+  double available = std::numeric_limits<double>::infinity();
+  if (std::ifstream meminfo("/proc/meminfo"); meminfo) {
+    double total = 0.0;
+    int found = 0;
+    for (std::string line; std::getline(meminfo, line);) {  // "MemAvailable:  123456 kB"
+      std::istringstream fields(line);
+      std::string key;
+      double kib = 0.0;
+      if ((fields >> key >> kib) && (key == "MemAvailable:" || key == "SwapFree:")) {
+        total += 1024.0 * kib;
+        ++found;
+      }
+    }
+    if (found == 2) available = total;
+  }
+  rlimit limit{};
+  if (getrlimit(RLIMIT_AS, &limit) == 0 && limit.rlim_cur != RLIM_INFINITY) {
+    double used = 0.0;
+    if (std::ifstream statm("/proc/self/statm"); statm) {
+      double pages = 0.0;
+      statm >> pages;
+      used = pages * static_cast<double>(sysconf(_SC_PAGESIZE));
+    }
+    available = std::min(available, static_cast<double>(limit.rlim_cur) - used);
+  }
+  return available;
+}
+
 }  // namespace
+
+void Simulation::require_memory(std::uint64_t bodies, std::size_t group) const {
+  const double needed = static_cast<double>(bodies) * kBytesPerBody;
+  const double available = available_memory();
+  if (needed > available) {
+    std::ostringstream out;
+    out << "generator: " << bodies << " bodies in all need about " << needed / 1e9
+        << " GB (" << kBytesPerBody << " bytes per body), more than the " << available / 1e9
+        << " GB this process can still take; lower count or enlarge the machine";
+    fail(scene_, group, out.str());
+  }
+}
+
+void Simulation::require_invertible_constants() const {
+  // Mass and moments grow with the radius (as r³ and r⁵): the extremes of the distribution give
+  // the extremes of both, and each must have a finite inverse (the step divides by them).
+  for (std::size_t g = 0; g < scene_.groups.size(); ++g) {
+    const BodyGroup& group = scene_.groups[g];
+    for (const double r : {group.radius.min(), group.radius.max()}) {
+      const BodyConstants c = constants_for(group, r);
+      const auto invertible = [](double x) {
+        return x > 0.0 && std::isfinite(x) && std::isfinite(1.0 / x);
+      };
+      if (invertible(c.inertia.m) && c.inertia.K_Theta.unaryExpr(invertible).all()) continue;
+      std::ostringstream out;
+      out << (group.shape == ShapeKind::box ? "half_extents" : "radius") << ", "
+          << (group.density ? "density" : "mass") << ": a body of "
+          << (group.shape == ShapeKind::box ? "this box" : "radius " + format_number(r) + " m")
+          << " and " << (group.density ? "density " + format_number(*group.density) + " kg/m³"
+                                       : "mass " + format_number(*group.mass) + " kg")
+          << " has the mass " << format_number(c.inertia.m) << " kg and the principal moments ("
+          << format_number(c.inertia.K_Theta[0]) << ", " << format_number(c.inertia.K_Theta[1])
+          << ", " << format_number(c.inertia.K_Theta[2])
+          << ") kg m²: expected values whose inverses are finite (the derived mass or inertia "
+             "under- or overflows the doubles)";
+      fail(scene_, g, out.str());
+    }
+  }
+}
 
 double largest_bounding_radius(const BodyGroup& group) {
   BodyConstants largest;
@@ -208,6 +284,7 @@ Simulation::Simulation(const Scene& scene, const SimulationState* state)
   }
   build_static();
   check_shapes();
+  require_invertible_constants();
   generators_.resize(scene.groups.size());
   if (state == nullptr) {
     for (std::size_t g = 0; g < scene.groups.size(); ++g) {
@@ -282,10 +359,8 @@ void Simulation::check_shapes() const {
   }
 }
 
-BodyConstants Simulation::make_constants(std::size_t group, Random& random) {
-  const BodyGroup& g = scene_.groups[group];
+BodyConstants Simulation::constants_for(const BodyGroup& g, double radius) const {
   BodyConstants c;
-  c.id = next_id_;
   c.shape = g.shape;
   c.material = *materials_.find(g.material);
   c.fixed = g.fixed;
@@ -296,12 +371,12 @@ BodyConstants Simulation::make_constants(std::size_t group, Random& random) {
       mass = body::box_mass_properties(g.half_extents, 1.0);
       break;
     case ShapeKind::capsule:
-      c.radius = g.radius.sample(random);
+      c.radius = radius;
       c.half_length = g.half_length;
       mass = body::capsule_mass_properties(c.radius, 2.0 * g.half_length, 1.0);
       break;
     default:
-      c.radius = g.radius.sample(random);
+      c.radius = radius;
       mass = body::sphere_mass_properties(c.radius, 1.0);
       break;
   }
@@ -309,6 +384,13 @@ BodyConstants Simulation::make_constants(std::size_t group, Random& random) {
   const double scale = g.density ? *g.density : *g.mass / mass.mass;
   c.inertia.m = mass.mass * scale;
   c.inertia.K_Theta = mass.M_Theta_S.diagonal() * scale;
+  return c;
+}
+
+BodyConstants Simulation::make_constants(std::size_t group, Random& random) {
+  const BodyGroup& g = scene_.groups[group];
+  BodyConstants c = constants_for(g, g.shape == ShapeKind::box ? 0.0 : g.radius.sample(random));
+  c.id = next_id_;
   return c;
 }
 
@@ -419,8 +501,11 @@ void Simulation::generate_initial() {
              "generator: the lattice would hold " + std::to_string(n) +
                  " bodies, more than 10⁸; give a count or a smaller region");
       }
-      const auto nx = static_cast<std::uint64_t>(cells.x());
-      const auto ny = static_cast<std::uint64_t>(cells.y());
+      // n ≤ 10⁸ sites are used: a row or layer longer than n is cut to n before the conversion
+      // (a huge region would overflow the integer), which leaves the sites used unchanged.
+      const auto nx = static_cast<std::uint64_t>(std::min(cells.x(), n));
+      const auto ny = static_cast<std::uint64_t>(std::min(cells.y(), n));
+      require_memory(system_.size() + static_cast<std::size_t>(n), g);
       system_.reserve(system_.size() + static_cast<std::size_t>(n));
       for (std::uint64_t k = 0; k < static_cast<std::uint64_t>(n); ++k) {
         const Vector3 site(static_cast<double>(k % nx), static_cast<double>((k / nx) % ny),
@@ -442,6 +527,7 @@ void Simulation::generate_initial() {
         fail(scene_, g,
              "generator.count: expected at most 10⁸ bodies, found " + std::to_string(spec.count));
       }
+      require_memory(system_.size() + spec.count, g);
       std::vector<BodyConstants> bodies;
       bodies.reserve(spec.count);
       double volume = 0.0;
@@ -521,8 +607,11 @@ void Simulation::inflow() {
     // after stop.
     double t_end = t + scene_.settings.dt;
     if (spec.stop > 0.0) t_end = std::min(t_end, spec.stop);
-    auto due = static_cast<std::uint64_t>(std::floor(spec.rate * (t_end - spec.start) + 1e-6));
-    if (spec.count > 0) due = std::min(due, spec.count);
+    // In floating point, clamped before the conversion: a rate · time beyond 2⁶⁴ would be
+    // undefined as an integer. No run places 2⁶² bodies; the rest waits as backlog.
+    const double owed = std::floor(spec.rate * (t_end - spec.start) + 1e-6);
+    const double cap = spec.count > 0 ? static_cast<double>(spec.count) : 0x1p62;
+    const auto due = static_cast<std::uint64_t>(std::clamp(owed, 0.0, cap));
     GeneratorState& state = generators_[g];
     if (due <= state.created) continue;
     Random random(state.random);
@@ -623,15 +712,31 @@ SimulationState Simulation::save() const {
 }
 
 void Simulation::restore(const SimulationState& state) {
-  const std::string where = scene_.file.string() + ": restart: ";
+  const auto refuse = [](const std::string& what) { throw StateError(what); };
   if (state.generators.size() != scene_.groups.size()) {
-    throw SceneError(where + "expected a checkpoint of a scene with " +
-                     std::to_string(scene_.groups.size()) + " body groups, found " +
-                     std::to_string(state.generators.size()));
+    refuse("expected the state of a scene with " + std::to_string(scene_.groups.size()) +
+           " body groups, found " + std::to_string(state.generators.size()));
   }
   if (state.bodies.size() != state.states.size() ||
       state.warm_keys.size() != state.warm_lambda.size()) {
-    throw SceneError(where + "the checkpoint's body or warm-start arrays differ in length");
+    refuse("the body or warm-start arrays differ in length");
+  }
+  // The clock counts steps of this scene's Δt: t and steps must agree to half a step.
+  const double dt = scene_.settings.dt;
+  if (!(std::abs(state.t / dt - static_cast<double>(state.steps)) <= 0.5)) {
+    refuse("t = " + format_number(state.t) + " s and steps = " + std::to_string(state.steps) +
+           " do not fit the scene's dt = " + format_number(dt) + " s (t / dt = " +
+           format_number(state.t / dt) + ")");
+  }
+  for (std::size_t g = 0; g < scene_.groups.size(); ++g) {
+    const GeneratorSpec& spec = scene_.groups[g].generator;
+    const std::uint64_t count =
+        spec.kind == GeneratorKind::list ? spec.positions.size() : spec.count;
+    if (count > 0 && state.generators[g].created > count) {
+      refuse("group " + std::to_string(g) + " (" + scene_.groups[g].name + ") has created " +
+             std::to_string(state.generators[g].created) + " bodies, more than its count " +
+             std::to_string(count));
+    }
   }
   generators_ = state.generators;
   next_id_ = state.next_id;
@@ -639,17 +744,54 @@ void Simulation::restore(const SimulationState& state) {
   removed_mass_ = state.removed_mass;
   system_.reserve(state.bodies.size());
   for (std::size_t i = 0; i < state.bodies.size(); ++i) {
-    if (state.bodies[i].material >= materials_.size()) {
-      throw SceneError(where + "body " + std::to_string(state.bodies[i].id) + " has material " +
-                       std::to_string(state.bodies[i].material) + ", the scene has " +
-                       std::to_string(materials_.size()));
+    const BodyConstants& c = state.bodies[i];
+    if (c.material >= materials_.size()) {
+      refuse("body " + std::to_string(c.id) + " has material " + std::to_string(c.material) +
+             ", the scene has " + std::to_string(materials_.size()));
     }
+    if (c.id >= next_id_) {
+      refuse("body " + std::to_string(c.id) + " has an id not below next_id = " +
+             std::to_string(next_id_));
+    }
+    require_from_scene(c);
     try {
-      system_.add(spec_of(state.bodies[i], state.states[i]));
+      system_.add(spec_of(c, state.states[i]));
     } catch (const InvalidArgument& e) {
-      throw SceneError(where + e.what());
+      refuse(e.what());
     }
   }
+}
+
+// A body of the state must be one that a group of the scene makes: its shape, material and
+// fixedness, a size the group's distribution can draw, and the mass and moments the group's
+// density or mass give it (to 10⁻¹² relative: a damaged or foreign value is refused).
+void Simulation::require_from_scene(const BodyConstants& c) const {
+  const auto close = [](double a, double b) {
+    return std::abs(a - b) <= 1e-12 * std::max(std::abs(a), std::abs(b));
+  };
+  for (const BodyGroup& g : scene_.groups) {
+    if (g.shape != c.shape || *materials_.find(g.material) != c.material || g.fixed != c.fixed)
+      continue;
+    if (c.shape == ShapeKind::box ? g.half_extents != c.half_extents
+                                  : !(c.radius >= g.radius.min() && c.radius <= g.radius.max()))
+      continue;
+    if (c.shape == ShapeKind::capsule && g.half_length != c.half_length) continue;
+    const BodyConstants expected = constants_for(g, c.radius);
+    if (close(expected.inertia.m, c.inertia.m) &&
+        close(expected.inertia.K_Theta[0], c.inertia.K_Theta[0]) &&
+        close(expected.inertia.K_Theta[1], c.inertia.K_Theta[1]) &&
+        close(expected.inertia.K_Theta[2], c.inertia.K_Theta[2])) {
+      return;
+    }
+  }
+  throw StateError("body " + std::to_string(c.id) + " (a " +
+                   std::string(collision::kind_name(c.shape)) + " of radius " +
+                   format_number(c.radius) + " m, mass " + format_number(c.inertia.m) +
+                   " kg, moments (" + format_number(c.inertia.K_Theta[0]) + ", " +
+                   format_number(c.inertia.K_Theta[1]) + ", " +
+                   format_number(c.inertia.K_Theta[2]) + ") kg m²) is not a body that a group "
+                   "of the scene makes: no group has its shape, material, size and the mass "
+                   "and inertia its density or mass gives");
 }
 
 }  // namespace grbd::scene

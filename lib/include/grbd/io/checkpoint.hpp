@@ -18,8 +18,9 @@ struct Checkpoint {
   std::string scene_text;        ///< the scene the run was started from
 };
 
-/// The format version written to and required from checkpoints.
-inline constexpr std::uint64_t kCheckpointFormatVersion = 1;
+/// The format version written to checkpoints. Version 2 adds the attribute `checksum` over every
+/// value; version 1 (without it) is still read.
+inline constexpr std::uint64_t kCheckpointFormatVersion = 2;
 
 /// Writes `checkpoint` to `path` atomically: into a temporary file beside it, flushed to the disk
 /// (fsync), then renamed over `path`, so that a crash at any moment leaves either the previous
@@ -27,7 +28,11 @@ inline constexpr std::uint64_t kCheckpointFormatVersion = 1;
 void write_checkpoint(const std::filesystem::path& path, const Checkpoint& checkpoint);
 
 /// Reads a checkpoint; throws IoError naming the file and the dataset or attribute that is
-/// missing, of the wrong shape, or holds values that are not finite or out of range.
+/// missing, of the wrong shape, or holds values that are not finite or out of range (a state,
+/// λ_N < 0, removed_mass, next_id ≥ 2⁶³, more steps than 10¹², counters beyond what was created),
+/// and "is damaged" when the values do not give the checksum written with them. What depends on
+/// the scene (Δt against t and steps, each body's mass and inertia) is checked by
+/// scene::Simulation's restart constructor.
 Checkpoint read_checkpoint(const std::filesystem::path& path);
 
 }  // namespace grbd::io

@@ -21,7 +21,9 @@
 #include <cstdint>
 #include <filesystem>
 #include <memory>
+#include <span>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "grbd/core/error.hpp"
@@ -48,16 +50,31 @@ struct OutputPosition {
 /// The format version written to and required from output files.
 inline constexpr std::uint64_t kOutputFormatVersion = 1;
 
+/// What identifies the run a restart continues: the output it reopens must be that run's.
+struct RunIdentity {
+  std::string scene_text;                        ///< the scene the run was started from
+  std::span<const scene::BodyConstants> bodies;  ///< the bodies at the checkpoint
+};
+
+/// The line (1, 2, …) on which two texts first differ.
+std::size_t first_different_line(std::string_view a, std::string_view b);
+
 /// The output file of a run. Steps are buffered and written with each record (or flush()).
+/// While it is open, the file is locked (flock, as HDF5 does): a second OutputFile of the same
+/// file, in this process or another, is refused before anything is changed.
 class OutputFile {
  public:
-  /// Creates `path` (replacing a file of that name) and the XDMF file beside it (`.xmf`).
+  /// Creates `path` (replacing a file of that name, once it holds the lock) and the XDMF file
+  /// beside it (`.xmf`). Throws IoError, having changed nothing, when another process holds
+  /// the file.
   OutputFile(const std::filesystem::path& path, const scene::Scene& scene);
   /// Reopens the output of an earlier run for a restart: keeps what `at` counts and drops the
-  /// rest (records, steps and bodies written after the checkpoint). Throws IoError when the file
-  /// is not a grbd output or holds less than `at`.
+  /// rest (records, steps and bodies written after the checkpoint). Throws IoError, having
+  /// changed nothing, when the file is not a grbd output, holds less than `at`, or belongs to
+  /// another run (its scene text is not `run.scene_text`, or a body of `run.bodies` is not in its
+  /// table with the same constants).
   OutputFile(const std::filesystem::path& path, const scene::Scene& scene,
-             const OutputPosition& at);
+             const OutputPosition& at, const RunIdentity& run);
   ~OutputFile();
   OutputFile(const OutputFile&) = delete;
   OutputFile& operator=(const OutputFile&) = delete;
@@ -71,7 +88,8 @@ class OutputFile {
   void flush(scene::Simulation& simulation);
   /// What has been written (after flush(): everything so far).
   OutputPosition position() const { return written_; }
-  /// Flushes and closes; throws IoError if HDF5 cannot. The destructor closes silently.
+  /// Flushes, closes and releases the lock; throws IoError if HDF5 cannot. The destructor closes
+  /// silently.
   void close(scene::Simulation& simulation);
   /// The XDMF file written beside `path`.
   static std::filesystem::path xdmf_path(const std::filesystem::path& path);
@@ -90,6 +108,20 @@ class OutputFile {
   };
   std::unique_ptr<Impl, Release> impl_;
   OutputPosition written_;
+};
+
+/// HDF5's clean-up at exit, taken over for a program's main(): construct one first thing in
+/// main(). HDF5 closes every file still open when the program exits; a file whose close failed (a
+/// write that found the disk full) is still on its list, and closing it again there crashes
+/// HDF5 1.10 (SIGSEGV in H5F__close_cb). With this object HDF5 installs no exit handler, and the
+/// destructor shuts it down only when no file is left open — which then only one HDF5 cannot
+/// close can be, left to the operating system.
+class Hdf5Cleanup {
+ public:
+  Hdf5Cleanup();
+  ~Hdf5Cleanup();
+  Hdf5Cleanup(const Hdf5Cleanup&) = delete;
+  Hdf5Cleanup& operator=(const Hdf5Cleanup&) = delete;
 };
 
 /// What `grbd info` says about an output file.

@@ -23,6 +23,9 @@ struct RunOptions {
   /// Continue from this checkpoint (the output is reopened and cut back to it, or created when
   /// it does not exist).
   std::optional<std::filesystem::path> restart;
+  /// Replace an existing output, its XDMF and checkpoint on a fresh run (`grbd run --force`);
+  /// without it a fresh run refuses to overwrite any of them.
+  bool overwrite = false;
   /// Set from a signal handler: the run finishes its step, writes a checkpoint and returns.
   const volatile std::sig_atomic_t* stop = nullptr;
   /// Called after every step (progress display).
@@ -36,6 +39,25 @@ struct RunOptions {
 /// `scene_file` and the two versions of it (`given` is the file's text, `saved` the other).
 std::string scene_difference(const std::string& saved, const std::string& given,
                              const std::filesystem::path& scene_file);
+
+/// A run's files that coincide (the output, its XDMF, the checkpoint, their temporary names, the
+/// scene, its meshes and the restart checkpoint must be different files), or a file name with a
+/// NUL character: a bad command line (`grbd run` exits 2).
+class FileConflict : public IoError {
+ public:
+  using IoError::IoError;
+};
+
+/// Whether two paths name the same file: the same device and inode when both exist (other
+/// spellings, links), else the same canonical path.
+bool same_file(const std::filesystem::path& a, const std::filesystem::path& b);
+
+/// Checks a run's files before anything is read, built or written: FileConflict for files that
+/// coincide or a NUL in a name; IoError naming the file for an output or checkpoint whose folder
+/// does not exist or cannot be written, a name that is a folder or not a regular file, an output
+/// that another process holds open, and, on a fresh run without `overwrite`, an output, XDMF or
+/// checkpoint that exists already. run() calls it first.
+void check_run_files(const scene::Scene& scene, const RunOptions& options);
 
 /// What a run did.
 struct RunResult {
@@ -51,8 +73,12 @@ struct RunResult {
 /// Runs `scene` to its end_time (or until *stop): a record at step 0 (fresh runs), every
 /// output.every steps and at the end; a checkpoint every checkpoint.every steps and at the end
 /// (before the last record when that is not a regular one, so that a restart from it gives the
-/// same records as an uninterrupted run). Throws SceneError or IoError for bad input before the
-/// first step, and grbd::Error when a step fails (the output then holds what was recorded).
+/// same records as an uninterrupted run). Throws FileConflict, SceneError or IoError for bad
+/// input before the first step (nothing changed: an existing output is truncated or cut back only
+/// after every check passed), IoError naming the restart checkpoint for one that does not fit the
+/// scene, and grbd::Error when a step fails (a blow-up, a diverged solver, a write that failed):
+/// the output then holds every record and step row before the failure, and the last checkpoint is
+/// the last valid state.
 RunResult run(const scene::Scene& scene, const RunOptions& options);
 
 }  // namespace grbd::io

@@ -139,13 +139,31 @@ struct Scene {
   std::uint64_t steps() const;
 };
 
+/// The most steps a run may have (end_time / Δt): the key end_time and `grbd run --end-time`
+/// obey it, and a checkpoint may not count more.
+inline constexpr std::uint64_t kMaxSteps = 1'000'000'000'000;
+
+/// Sets `scene.end_time` under the rules of the key [simulation] end_time: a finite time > 0 of
+/// at most kMaxSteps steps of Δt. Throws SceneError naming `source` (e.g. "--end-time") and the
+/// value otherwise.
+void set_end_time(Scene& scene, double end_time, std::string_view source);
+
+/// A time or other real number given as text (a command-line option): a decimal number as in a
+/// scene file ("0.5", "2e-3"); throws SceneError naming `source` for anything else (empty text,
+/// hexadecimal, "inf", "nan", trailing characters).
+double parse_real(std::string_view text, std::string_view source);
+
 /// Reads a scene from TOML text. `file` names it in messages and is the folder that relative
 /// mesh paths are resolved against. Throws SceneError for a syntax error, an unknown key (with
 /// the closest known key suggested), a value of the wrong type or out of range, a material that
 /// is not declared, a pair of materials without a law, and a mesh that cannot be read.
 Scene parse_scene(std::string_view text, const std::filesystem::path& file);
 
-/// Reads the scene file `file` (SceneError also when it cannot be read).
+/// The largest scene file read (a scene of 10⁵ static objects takes a few MiB).
+inline constexpr std::size_t kMaxSceneBytes = std::size_t{64} << 20;
+
+/// Reads the scene file `file` (SceneError also when it cannot be read, is not a regular file or
+/// is larger than kMaxSceneBytes).
 Scene load_scene(const std::filesystem::path& file);
 
 /// A few lines that say what a scene holds (for `grbd validate`).

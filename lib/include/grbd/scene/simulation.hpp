@@ -54,6 +54,19 @@ struct SimulationState {
   std::vector<GeneratorState> generators;       ///< one per body group
 };
 
+/// A saved state (a checkpoint's) that does not fit the scene it is restored into, or holds a
+/// body the scene cannot make. The message names what, not the file: the caller knows the file.
+class StateError : public Error {
+ public:
+  using Error::Error;
+};
+
+/// The memory a body takes in a running granular scene [bytes]: the system, the stepper and its
+/// contacts (about six per body in a dense packing), as chapter 6's step benchmark measures it
+/// (3.4–4.2 KiB per sphere after a step). What a scene asks for is compared with what the process
+/// can still take before anything is allocated.
+inline constexpr double kBytesPerBody = 4096.0;
+
 /// A runnable scene. Construction generates the initial bodies (list, lattice and packing
 /// groups) and checks everything the stepper checks (materials of every pair, supported shape
 /// pairs); a scene that cannot run throws SceneError before the first step.
@@ -61,8 +74,10 @@ class Simulation {
  public:
   /// Builds the scene and its initial bodies.
   explicit Simulation(const Scene& scene);
-  /// Builds the scene and continues from `state` instead (restart); throws SceneError when the
-  /// state does not fit the scene (a material or group it does not have).
+  /// Builds the scene and continues from `state` instead (restart); throws StateError when the
+  /// state does not fit the scene: another number of groups, t and steps that do not agree with
+  /// Δt, a material it does not have, a body that no group makes (shape, material, size, mass and
+  /// inertia from its density or mass), or a body the system refuses.
   Simulation(const Scene& scene, const SimulationState& state);
   ~Simulation();
   Simulation(const Simulation&) = delete;
@@ -108,6 +123,10 @@ class Simulation {
   void outlet();
   void check_shapes() const;
   BodyConstants make_constants(std::size_t group, Random& random);
+  BodyConstants constants_for(const BodyGroup& group, double radius) const;
+  void require_invertible_constants() const;
+  void require_memory(std::uint64_t bodies, std::size_t group) const;
+  void require_from_scene(const BodyConstants& body) const;
   // The deepest overlap of a body (its constants and a state) with the static geometry: the gap
   // (< 0 when they overlap, +∞ without static objects) and the static object's index.
   std::pair<double, std::size_t> static_gap(const BodyConstants& c, const body::State& x);
