@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <charconv>
 #include <cmath>
+#include <cstdio>
 #include <fstream>
 #include <limits>
 #include <memory>
@@ -111,7 +112,17 @@ std::string describe(const toml::node& node) {
   } else if (const auto* s = node.as_string()) {
     std::string text = s->get();
     if (text.size() > 40) text = text.substr(0, 40) + "…";
-    out << "the string \"" << text << "\"";
+    out << "the string \"";
+    for (const char c : text) {  // control characters (a NUL) as TOML escapes, never raw
+      if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) {
+        char escape[8];
+        std::snprintf(escape, sizeof(escape), "\\u%04x", static_cast<unsigned>(c));
+        out << escape;
+      } else {
+        out << c;
+      }
+    }
+    out << "\"";
   } else if (const auto* b = node.as_boolean()) {
     out << (b->get() ? "true" : "false");
   } else if (const auto* a = node.as_array()) {
