@@ -39,7 +39,24 @@ def scene_text(body, extra=""):
             "material = \"glass\"\n" + body + "\n" + extra)
 
 
-class NoResultIsLost(Scratch):
+class Faults(Scratch):
+    """A test folder with a helper to write the files a case needs."""
+
+    def write(self, name, text):
+        path = self.path(name)
+        with open(path, "w") as f:
+            f.write(text)
+        return path
+
+    def chute_with(self, name, old, new):
+        """The test scene with one piece of text replaced."""
+        with open(SCENE) as f:
+            text = f.read()
+        self.assertIn(old, text)
+        return self.write(name, text.replace(old, new))
+
+
+class NoResultIsLost(Faults):
     """Classes 1-3: the output, its XDMF, the checkpoint, the scene and other inputs."""
 
     def first_run(self, out="out.h5", ckpt="out.ckpt.h5", end="0.05"):
@@ -121,11 +138,7 @@ class NoResultIsLost(Scratch):
             self.assertEqual(len(f["steps"]), 20)
 
     def test_a_restart_into_the_output_of_another_run_is_refused(self):
-        with open(SCENE) as f:
-            text = f.read()
-        other = self.path("other.toml")
-        with open(other, "w") as f:
-            f.write(text.replace("mu = 0.4", "mu = 0.1"))
+        other = self.chute_with("other.toml", "mu = 0.4", "mu = 0.1")
         theirs, _ = self.first_run("theirs.h5", "theirs.ckpt.h5")
         result = run("run", other, "-q", "-o", self.path("mine.h5"), "-c",
                      self.path("mine.ckpt.h5"), "--end-time", "0.025")
@@ -138,13 +151,9 @@ class NoResultIsLost(Scratch):
         self.assertEqual(text_of(theirs), before)
 
     def test_a_nul_in_a_file_name_is_refused(self):
-        victim = self.path("victim.txt")
-        with open(victim, "w") as f:
-            f.write("keep me")
-        scene = self.path("nul.toml")
-        with open(scene, "w") as f:
-            f.write(scene_text('positions = [[0.0, 0.0, 0.0]]',
-                               '[output]\nfile = "victim.txt\\u0000.h5"\n'))
+        victim = self.write("victim.txt", "keep me")
+        scene = self.write("nul.toml", scene_text('positions = [[0.0, 0.0, 0.0]]',
+                                                  '[output]\nfile = "victim.txt\\u0000.h5"\n'))
         result = run("run", scene, "-q", cwd=self.dir)
         self.assertEqual(result.returncode, 3, result.stderr)
         self.assertIn("output.file: expected a file name without NUL characters, found the "
@@ -161,22 +170,18 @@ class NoResultIsLost(Scratch):
             self.assertEqual(result.returncode, 2, result.stderr)
             self.assertIn("it would be destroyed", result.stderr)
         self.assertEqual(text_of(problem), before)
-        keep = self.path("keep.csv")
-        with open(keep, "w") as f:
-            f.write("an earlier table\n")
+        keep = self.write("keep.csv", "an earlier table\n")
         result = run("fclib", problem, SCENE, "--max-iterations", "5", "--csv", keep)
         self.assertEqual(result.returncode, 3, result.stderr)
         self.assertEqual(text_of(keep), b"an earlier table\n")
         self.assertEqual(sorted(os.listdir(self.dir)), ["keep.csv", "problem.hdf5"])
 
 
-class BlowUpsAreErrors(Scratch):
+class BlowUpsAreErrors(Faults):
     """Class 4: a step that leaves a non-finite state stops the run; class 5: huge rates."""
 
     def run_scene(self, text, *args):
-        scene = self.path("s.toml")
-        with open(scene, "w") as f:
-            f.write(text)
+        scene = self.write("s.toml", text)
         return run("run", scene, "-q", "-o", self.path("o.h5"), "-c", self.path("c.h5"), *args)
 
     def test_a_blow_up_stops_the_run_naming_step_time_and_body(self):
@@ -199,12 +204,11 @@ class BlowUpsAreErrors(Scratch):
         self.assertIn("simulation.gravity: expected a vector of magnitude below", result.stderr)
 
     def test_a_silo_under_a_huge_gravity_stops_at_its_first_step(self):
-        with open(SCENE) as f:
-            text = f.read()
         # Finite energies, but after one step the beads are 10¹⁴³ m out, where doubles are
         # 10¹²⁷ m apart: every bead would touch every other.
-        result = self.run_scene(text.replace("gravity = [0.0, 0.0, -9.81]",
-                                             "gravity = [1e150, 1e150, 1e150]"))
+        scene = self.chute_with("s.toml", "gravity = [0.0, 0.0, -9.81]",
+                                "gravity = [1e150, 1e150, 1e150]")
+        result = run("run", scene, "-q", "-o", self.path("o.h5"), "-c", self.path("c.h5"))
         self.assertEqual(result.returncode, 1, result.stderr)
         self.assertRegex(result.stderr, r"step 1 \(t = 0\.0005\d* s\): body \d+ blew up")
         self.assertIn("more than 10¹² bounding radii from the origin", result.stderr)
@@ -219,34 +223,28 @@ class BlowUpsAreErrors(Scratch):
             self.assertGreater(len(f["bodies"]), 100)  # 0 when the count overflowed
 
 
-class RefusalsComeFirst(Scratch):
+class RefusalsComeFirst(Faults):
     """Classes 6-8 and 11: refused before the first step, naming the right file."""
 
     def test_an_output_path_that_cannot_be_written_is_refused_before_the_run(self):
         os.mkdir(self.path("sub"))
-        scene = self.path("s.toml")
-        with open(SCENE) as f:
-            text = f.read()
-        with open(scene, "w") as f:  # a checkpoint only at the end of a long run
-            f.write(text.replace("every = 100", "every = 0"))
+        # A checkpoint only at the end of a long run: refused at once, or the test's time limit
+        # ends it.
+        scene = self.chute_with("s.toml", "every = 100", "every = 0")
         out, ckpt = self.path("o.h5"), self.path("c.h5")
         for args, message in ((["-o", out, "-c", self.path("nodir/c.h5")], "does not exist"),
                               (["-o", out, "-c", self.path("sub")], "it is a folder"),
                               (["-o", out, "-c", ""], 'expected a file name, found ""'),
                               (["-o", self.path("nodir/o.h5"), "-c", ckpt], "does not exist"),
                               (["-o", "/dev/null", "-c", ckpt], "not a regular file")):
-            start = time.time()
             result = run("run", scene, "-q", *args, "--end-time", "100")
             self.assertEqual(result.returncode, 3, (args, result.stderr))
             self.assertIn(message, result.stderr)
-            self.assertLess(time.time() - start, 30)  # refused before 200 000 steps
             self.assertEqual(sorted(os.listdir(self.dir)), ["s.toml", "sub"], args)
             self.assertEqual(os.listdir(self.path("sub")), [])
 
     def test_end_time_obeys_the_rules_of_the_scene_key(self):
-        out = self.path("out.h5")
-        with open(out, "w") as f:
-            f.write("an earlier file")
+        out = self.write("out.h5", "an earlier file")
         for value, message in (("", "expected a decimal number"),
                                ("0x10", "expected a decimal number"),
                                ("inf", "expected a decimal number"),
@@ -271,13 +269,12 @@ class RefusalsComeFirst(Scratch):
         self.assertFalse(os.path.exists(self.path("o.h5")))
 
     def test_a_scene_larger_than_memory_is_refused_before_allocating(self):
-        scene = self.path("big.toml")
-        with open(scene, "w") as f:
-            f.write(scene_text('[bodies.generator]\nkind = "packing"\ncount = 100000000\n'
-                               'region = { min = [0, 0, 0], max = [100, 100, 100] }')
-                    .replace("radius = 0.01\n", "radius = 0.001\n"))
+        scene = self.write("big.toml", scene_text(
+            '[bodies.generator]\nkind = "packing"\ncount = 100000000\n'
+            'region = { min = [0, 0, 0], max = [100, 100, 100] }').replace(
+                "radius = 0.01\n", "radius = 0.001\n"))
 
-        def limit():  # 4 GB of address space: 10⁸ bodies need about 70 GB
+        def limit():  # 4 GB of address space: 10⁸ bodies need hundreds of GB
             resource.setrlimit(resource.RLIMIT_AS, (4 << 30, 4 << 30))
 
         result = subprocess.run([test_cli.GRBD, "validate", scene], capture_output=True,
@@ -287,45 +284,36 @@ class RefusalsComeFirst(Scratch):
         self.assertIn("GB", result.stderr)
 
     def test_messages_name_the_file_the_group_and_the_key(self):
-        scene = self.path("m.toml")
         for body, message in (
                 ("radius = 1e-300", "radius, density: a body of radius 1e-300 m"),
                 ("mass = 1e308", "radius, mass: a body of radius 0.01 m and mass 1e+308 kg")):
             text = scene_text("positions = [[0.0, 0.0, 0.0]]")
             text = text.replace("radius = 0.01\n", "radius = 1e-300\n") if "radius" in body \
                 else text.replace("density = 2500.0\n", body + "\n")
-            with open(scene, "w") as f:
-                f.write(text)
+            scene = self.write("m.toml", text)
             result = run("validate", scene)
             self.assertEqual(result.returncode, 3, result.stderr)
             self.assertIn("m.toml: bodies[0] (bodies[0]): " + message, result.stderr)
             self.assertIn("under- or overflows", result.stderr)
-        with open(scene, "w") as f:
-            f.write(scene_text("positions = [[0.0, 0.0, 0.0]]") +
-                    "".join(f'[[material]]\nname = "m{k}"\n' for k in range(1024)))
-        start = time.time()
+        scene = self.write("m.toml", scene_text("positions = [[0.0, 0.0, 0.0]]") +
+                           "".join(f'[[material]]\nname = "m{k}"\n' for k in range(1024)))
         result = run("validate", scene)
         self.assertEqual(result.returncode, 3, result.stderr)
         self.assertRegex(result.stderr, r"m\.toml:\d+:\d+: material\[1024\]\.name: expected at "
                                         r"most 1024 materials")
-        self.assertLess(time.time() - start, 10)
 
     def test_a_mesh_that_is_not_obj_is_not_quoted(self):
-        secret = self.path("secret.txt")
-        with open(secret, "w") as f:
-            f.write("root:x:0:0:secret-words:/root:/bin/bash\n")
-        scene = self.path("mesh.toml")
-        with open(scene, "w") as f:
-            f.write(scene_text("positions = [[0.0, 0.0, 0.5]]",
-                               '[[static]]\nshape = "mesh"\nfile = "secret.txt"\n'
-                               'material = "glass"\n'))
+        self.write("secret.txt", "root:x:0:0:secret-words:/root:/bin/bash\n")
+        scene = self.write("mesh.toml", scene_text("positions = [[0.0, 0.0, 0.5]]",
+                                                   '[[static]]\nshape = "mesh"\n'
+                                                   'file = "secret.txt"\nmaterial = "glass"\n'))
         result = run("validate", scene)
         self.assertEqual(result.returncode, 3, result.stderr)
         self.assertIn("secret.txt:1: expected a statement", result.stderr)
         self.assertNotIn("secret-words", result.stderr)
 
 
-class CheckpointsAreChecked(Scratch):
+class CheckpointsAreChecked(Faults):
     """Class 9: a checkpoint is checked, and named, before the first step."""
 
     def make(self):
@@ -400,15 +388,11 @@ class CheckpointsAreChecked(Scratch):
               "bit-identically", file=sys.stderr)
 
 
-class FullDisks(Scratch):
+class FullDisks(Faults):
     """Class 10: a write that fails (a file size limit, as a full disk) ends cleanly."""
 
     def test_a_write_that_fails_exits_1_and_the_last_checkpoint_restarts(self):
-        with open(SCENE) as f:
-            text = f.read()
-        scene = self.path("s.toml")
-        with open(scene, "w") as f:
-            f.write(text.replace("every = 25\n", "every = 1\n"))
+        scene = self.chute_with("s.toml", "every = 25\n", "every = 1\n")
 
         def limit():  # writes beyond 4 MB fail with EFBIG, as on a full disk
             signal.signal(signal.SIGXFSZ, signal.SIG_IGN)
