@@ -63,20 +63,23 @@ void check_run_files(const scene::Scene& scene, const RunOptions& options) {
   struct File {
     fs::path path;
     std::string role;
+    // The checkpoint may be the restart checkpoint: it is read before the first checkpoint
+    // replaces it.
+    bool checkpoint = false;
   };
   const fs::path xdmf = OutputFile::xdmf_path(options.output);
   // What the run writes: the checkpoint and the XDMF are renamed into place from a temporary.
   const std::vector<File> written = {
       {options.output, "the output"},
       {xdmf, "the output's XDMF"},
-      {options.checkpoint, "the checkpoint"},
+      {options.checkpoint, "the checkpoint", true},
       {options.checkpoint.string() + ".tmp", "the checkpoint's temporary file"},
       {xdmf.string() + ".tmp", "the XDMF's temporary file"}};
   std::vector<File> read = {{scene.file, "the scene file"}};
   for (const scene::StaticSpec& s : scene.statics) {
     if (!s.mesh_file.empty()) read.push_back({s.mesh_file, "the mesh of static " + s.name});
   }
-  if (options.restart) read.push_back({*options.restart, "the restart checkpoint"});
+  if (options.restart) read.push_back({*options.restart, "the restart checkpoint", true});
   const auto quoted = [](const fs::path& path) {
     std::string text = "\"";
     text += path.string();
@@ -103,8 +106,7 @@ void check_run_files(const scene::Scene& scene, const RunOptions& options) {
       }
     }
     for (const File& input : read) {
-      // The restart checkpoint is read before the first checkpoint replaces it: they may be one.
-      if (i == 2 && options.restart && &input == &read.back()) continue;
+      if (written[i].checkpoint && input.checkpoint) continue;
       if (same_file(written[i].path, input.path)) {
         throw FileConflict(written[i].role + " " + quoted(written[i].path) + " is " + input.role +
                            " " + quoted(input.path) + ": it would be destroyed");
