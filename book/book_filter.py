@@ -13,12 +13,17 @@ numbers of the source (so Doxygen's warnings still point at the right line):
   blocks) are resolved here, against the sections given by `--sections=NAME,...` (which the build
   sets from the tools it found, in place of Doxygen's ENABLED_SECTIONS): the lines of the branch not
   taken, and the directives, become empty lines, so figures are numbered as the reader sees them.
+- A number a demo computes reaches the text from the demo's own output at build time:
+  `\\demo{FOLDER/values.txt#KEY}` is replaced by the value of `KEY = VALUE` in that file of the
+  build's figures folder (`--figures=DIR`); a missing file or key is a BOOK ERROR, never a number
+  copied by hand.
 - Every chapter gets previous/next links, at the top (in place of the blank line after the title)
   and at the bottom, following the order of the chapter folders; the last chapter leads to the
   bibliography.
 
 Problems (an exercise without a marker in solutions/, a heading that carries its own title, a
-reference to an unknown figure) are written into the page as visible text starting with
+reference to an unknown figure, a `\\snippet` whose lines hold an exercise region's BEGIN or END
+marker, which would print the solution) are written into the page as visible text starting with
 "BOOK ERROR", which the book check (tests/book/check_book.py) refuses, and to stderr.
 """
 
@@ -39,6 +44,9 @@ IMAGE = re.compile(r'^(?P<indent>\s*)\\image\s+html\s+(?P<file>(?P<name>[\w.-]+)
 CONDITION = re.compile(r"^\s*\\(?P<directive>if|else|endif)\b\s*(?P<name>\w*)\s*$")
 FENCE = re.compile(r"^\s*(```|~~~)")
 FIGREF = re.compile(r"\\figref\{(?P<name>[\w.-]+)\}")
+DEMO_VALUE = re.compile(r"\\demo\{(?P<file>[\w./-]+)#(?P<key>[\w.-]+)\}")
+SNIPPET = re.compile(r"^\s*\\snippet\s+(?P<file>\S+)\s+(?P<tag>.+?)\s*$")
+EXERCISE_MARKER = re.compile(r"//\s*(?:BEGIN|END) EXERCISE (?P<id>\d+\.\d+)")
 
 
 def chapter_heading(text: str) -> re.Match | None:
@@ -80,6 +88,44 @@ def navigation(i: int, pages: list[tuple[str, str]], where: str) -> str:
             f"{nxt}</div>")
 
 
+def snippet_exercise(file: str, tag: str) -> str | None:
+    """The exercise ('N.M') whose region the snippet `tag` of `file` shows any of, or None: the
+    lines between the two `[tag]` markers, as Doxygen's \\snippet cuts them."""
+    path = ROOT / file
+    if not path.is_file():
+        return None  # Doxygen itself warns about a missing file
+    marker = f"[{tag}]"
+    inside = False
+    region = None  # the exercise whose region the current line is in
+    for line in path.read_text(encoding="utf-8").split("\n"):
+        if marker in line:
+            if inside:
+                return None
+            if region:
+                return region  # the snippet starts inside a region
+            inside = True
+            continue
+        m = EXERCISE_MARKER.search(line)
+        if m:
+            if inside:
+                return m.group("id")
+            region = m.group("id") if "BEGIN" in m.group(0) else None
+    return None
+
+
+def demo_values(figures: pathlib.Path | None, file: str) -> dict[str, str] | None:
+    """The `key = value` lines of a demo's values file in the build's figures folder, or None
+    when there is none (no folder given, the demo did not run, the file is missing)."""
+    if figures is None or not (figures / file).is_file():
+        return None
+    values = {}
+    for line in (figures / file).read_text(encoding="utf-8").split("\n"):
+        key, equals, value = line.partition("=")
+        if equals and key.strip():
+            values[key.strip()] = value.strip()
+    return values
+
+
 def book_error(message: str, path: pathlib.Path, line: int) -> str:
     print(f"{path}:{line}: book_filter: {message}", file=sys.stderr)
     return f"BOOK ERROR: {message}"
@@ -116,7 +162,8 @@ def resolve_sections(lines: list[str], sections: set[str], path: pathlib.Path) -
     return out
 
 
-def filter_chapter(path: pathlib.Path, text: str, sections: set[str] | None = None) -> str:
+def filter_chapter(path: pathlib.Path, text: str, sections: set[str] | None = None,
+                   figure_dir: pathlib.Path | None = None) -> str:
     m = chapter_heading(text)
     if not m:
         return text  # not a chapter page: leave it alone
@@ -138,7 +185,13 @@ def filter_chapter(path: pathlib.Path, text: str, sections: set[str] | None = No
     for i, line in enumerate(lines):
         heading = EXERCISE.match(line)
         image = IMAGE.match(line)
-        if heading:
+        snippet = SNIPPET.match(line)
+        shown = snippet and snippet_exercise(snippet.group("file"), snippet.group("tag"))
+        if shown:
+            line = book_error(f"\\snippet {snippet.group('file')} {snippet.group('tag')} shows "
+                              f"the region of Exercise {shown}, which the reader is to write: "
+                              "quote the declaration, or a part outside the region", path, i + 1)
+        elif heading:
             ex_id, rest = heading.group("id"), heading.group("rest").strip()
             if rest:
                 line = book_error(f"the heading of Exercise {ex_id} carries its own title "
@@ -165,6 +218,19 @@ def filter_chapter(path: pathlib.Path, text: str, sections: set[str] | None = No
             return f'\\ref {figure_anchor(name)} "{figures[name]}"'
 
         line = FIGREF.sub(figref, line)
+
+        def demo_value(ref: re.Match) -> str:
+            values = demo_values(figure_dir, ref.group("file"))
+            if values is None:
+                return book_error(f"\\demo{{{ref.group('file')}#{ref.group('key')}}}: no file "
+                                  f"{ref.group('file')} in the figures folder {figure_dir} (run the "
+                                  "demo: the build's target figures)", path, i + 1)
+            if ref.group("key") not in values:
+                return book_error(f"\\demo{{{ref.group('file')}#{ref.group('key')}}}: the demo "
+                                  f"wrote no value {ref.group('key')}", path, i + 1)
+            return values[ref.group("key")]
+
+        line = DEMO_VALUE.sub(demo_value, line)
         if i == 1 and not line.strip() and position is not None:
             line = navigation(position, pages, "top")
         out.append(line)
@@ -178,15 +244,23 @@ def filter_chapter(path: pathlib.Path, text: str, sections: set[str] | None = No
 def main() -> int:
     args = sys.argv[1:]
     sections: set[str] = set()
-    if args and args[0].startswith("--sections="):
-        sections = {name for name in args.pop(0)[len("--sections="):].split(",") if name}
+    figures: pathlib.Path | None = None
+    while args and args[0].startswith("--"):
+        option = args.pop(0)
+        if option.startswith("--sections="):
+            sections = {name for name in option[len("--sections="):].split(",") if name}
+        elif option.startswith("--figures="):
+            figures = pathlib.Path(option[len("--figures="):])
+        else:
+            args = []
+            break
     if len(args) != 1:
-        print("usage: book_filter.py [--sections=NAME,...] <page.md>  (a Doxygen INPUT_FILTER)",
-              file=sys.stderr)
+        print("usage: book_filter.py [--sections=NAME,...] [--figures=DIR] <page.md>  (a Doxygen "
+              "INPUT_FILTER)", file=sys.stderr)
         return 2
     path = pathlib.Path(args[0])
     text = path.read_text(encoding="utf-8")
-    sys.stdout.write(filter_chapter(path, text, sections))
+    sys.stdout.write(filter_chapter(path, text, sections, figures))
     return 0
 
 

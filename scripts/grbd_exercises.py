@@ -3,7 +3,8 @@
 A region in a file under solutions/NN-topic/ looks like
 
     // BEGIN EXERCISE 1.3: the rotation matrix R(p)
-    // Hint: lines like this one, directly after BEGIN, are kept in the stub.
+    // Hint: lines like this one, directly after BEGIN, are kept in the stub; a hint that goes
+    //   on over more lines indents them under its text.
     ... reference code ...
     // END EXERCISE 1.3
 
@@ -23,6 +24,10 @@ BEGIN = re.compile(r"^(?P<indent>[ \t]*)// BEGIN EXERCISE (?P<id>\d+\.\d+): (?P<
 END = re.compile(r"^[ \t]*// END EXERCISE (?P<id>\d+\.\d+)\s*$")
 MARKER = re.compile(r"//\s*(BEGIN|END)\s+EXERCISE")
 HINT = re.compile(r"^[ \t]*// Hint:")
+# A hint that goes on over more lines indents them under its text: "//   more of the hint".
+HINT_CONTINUED = re.compile(r"^[ \t]*//  +\S")
+COMMENT = re.compile(r"^[ \t]*//")
+SENTENCE_END = re.compile(r"[.!?:;)]\s*$")
 CHAPTER_DIR = re.compile(r"^(?P<number>\d\d)-[a-z0-9-]+$")
 CHAPTER_TITLE = re.compile(r"^#\s+(?P<title>Chapter\s+(?P<number>\d+):.*?)\s*"
                            r"(?:\{#(?P<label>[A-Za-z0-9_]+)\})?\s*$")
@@ -135,6 +140,16 @@ def transform(text: str, source: str, chapter_dir: str, title: str) -> tuple[str
         while j < len(lines) and HINT.match(lines[j]):
             out.append(lines[j])
             j += 1
+            while j < len(lines) and HINT_CONTINUED.match(lines[j]):
+                out.append(lines[j])
+                j += 1
+            # A hint cut off mid-sentence by a comment line that is not indented as its
+            # continuation would lose its end in the stub.
+            if (not SENTENCE_END.search(out[-1]) and j < len(lines) and COMMENT.match(lines[j])
+                    and not HINT.match(lines[j]) and not MARKER.search(lines[j])):
+                raise ExerciseError(f"{source}:{j + 1}: the hint above goes on here: indent its "
+                                    "continuation ('//   …') so that the stub keeps it, or end "
+                                    "the hint with a full stop")
         while j < len(lines) and not END.match(lines[j]):
             if BEGIN.match(lines[j]) or MARKER.search(lines[j]):
                 raise ExerciseError(f"{source}:{j + 1}: exercise region {ex_id} opened at line "

@@ -30,6 +30,7 @@
 //   pile.csv           step, t, then per run (warm, cold): kinetic energy, contacts, iterations,
 //                      converged, largest penetration, natural-map residual ‖F‖
 //   validation.txt     the summary lines the demo prints: measured errors against the closed forms
+//   values.txt         key = value lines that the chapter quotes (\demo{…} in chapter.md)
 //
 // Usage: ch06_validation <data directory>.
 
@@ -67,6 +68,24 @@ constexpr double kG = 9.81;
 
 /// The summary: printed and kept for validation.txt.
 std::string summary;
+
+/// Values the chapter's text quotes (`\demo{ch06_validation/values.txt#KEY}` in chapter.md): one
+/// `key = value` line each, written to values.txt.
+std::string values;
+
+void value(const char* key, const char* format, auto... args) {
+  char text[256];
+  std::snprintf(text, sizeof text, format, args...);
+  values += std::string(key) + " = " + text + "\n";
+}
+
+/// x as TeX, "8.6\cdot10^{-7}", two significant digits.
+std::string tex_power(double x) {
+  const int exponent = static_cast<int>(std::floor(std::log10(x)));
+  char text[64];
+  std::snprintf(text, sizeof text, "%.1f\\cdot10^{%d}", x / std::pow(10.0, exponent), exponent);
+  return text;
+}
 
 void say(const char* format, auto... args) {
   char line[512];
@@ -501,6 +520,8 @@ void pile(const std::filesystem::path& dir) {
     out << row;
   }
   out.finish();
+  value("pile.steps", "%zu", warm.reports.size());
+  long iterations_of[2] = {0, 0};
   for (const PileRun* run : {&warm, &cold}) {
     // Iterations over the steps with contacts, and over the last quarter (the settled pile).
     long total = 0;
@@ -522,6 +543,16 @@ void pile(const std::filesystem::path& dir) {
       penetration = std::max(penetration, report.max_penetration);
     }
     const StepReport& last = run->reports.back();
+    const std::string key = run == &warm ? "pile.warm." : "pile.cold.";
+    iterations_of[run == &warm ? 0 : 1] = total;
+    value((key + "iterations").c_str(), "%.0f", double(total) / double(steps));
+    value((key + "iterations_late").c_str(), "%.0f", double(late) / late_steps);
+    value((key + "capped").c_str(), "%d", non_converged);
+    value((key + "residual_late").c_str(), "%s",
+          tex_power(std::exp(log_residual / late_steps)).c_str());
+    value((key + "contacts").c_str(), "%zu", last.contacts);
+    value((key + "cpu").c_str(), "%.1f", run->seconds);
+    value((key + "penetration").c_str(), "%s", tex_power(penetration).c_str());
     say("pile of %zu spheres (r = %.0e m, mu = 0.5), %s start, dt = %.0e s, %.1f s: %zu contacts "
         "at the end, E_kin %.1e J; iterations per step %.1f on average, %.1f over the last "
         "quarter (geometric mean of the residual ||F|| there %.1e); %d of %zu steps at "
@@ -532,6 +563,9 @@ void pile(const std::filesystem::path& dir) {
         std::exp(log_residual / late_steps), non_converged, steps, penetration, penetration / r,
         run->seconds);
   }
+  value("pile.warm.saves_iterations", "%.0f",
+        100.0 * (1.0 - double(iterations_of[0]) / double(iterations_of[1])));
+  value("pile.warm.saves_time", "%.0f", 100.0 * (1.0 - warm.seconds / cold.seconds));
 }
 
 }  // namespace
@@ -540,7 +574,7 @@ int main(int argc, char** argv) {
   if (const auto exit_code = grbd::demo::check_arguments(
           argc, argv, kProgram, {"<data directory>"},
           "writes bouncing_ball.csv, impacts.csv, zeno.csv, incline.csv, billiard.csv, "
-          "cradle.csv, pile.csv and validation.txt")) {
+          "cradle.csv, pile.csv, validation.txt and values.txt (the numbers the chapter quotes)")) {
     return *exit_code;
   }
   try {
@@ -555,6 +589,9 @@ int main(int argc, char** argv) {
     grbd::demo::OutputFile table(dir / "validation.txt");
     table << summary;
     table.finish();
+    grbd::demo::OutputFile quoted(dir / "values.txt");
+    quoted << values;
+    quoted.finish();
     return 0;
   } catch (...) {
     return grbd::demo::report_exception(kProgram, "Exercises 6.1-6.6");

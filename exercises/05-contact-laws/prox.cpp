@@ -39,6 +39,7 @@ Vector2 prox_disk(const Vector2& x, double radius) {
   // Hint: compare ‖x‖² with ρ² first: no square root (and no division) when x is inside.
   // Hint: count ‖x‖ = ρ as inside, or x = 0 in the disk of radius 0 becomes 0/0.
   // Hint: ‖x‖² overflows for |x| ≳ 10¹⁵⁴ (and ρ² for ρ ≳ 10¹⁵⁴) although ‖x‖ does not: outside
+  //   the normal range of doubles, compare ‖x‖ from grbd::norm2d with ρ instead.
   throw grbd::NotImplemented("Exercise 5.2", "the prox onto the disk of radius ρ",
                              "Chapter 5: Prox contact laws and solvers",
                              "exercises/05-contact-laws/prox.cpp");
@@ -211,7 +212,7 @@ template <bool Isotropic>
     prefetch_ahead(contacts, i, n, 16, U, M_inv);  // 136-byte records: 16 ahead
     const CompactContact& c = contacts[i];
     const Vector3 t2 = c.t2();
-    // γ = Fᵀ(v_a + ω_a × r_a − v_b − ω_b × r_b), then ξ = γ + ε ∘ γ_A.
+    // γ = Bᵀ(v_a + ω_a × r_a − v_b − ω_b × r_b), B = [n t1 t2], then ξ = γ + ε ∘ γ_A.
     double w[3] = {0.0, 0.0, 0.0};
     if (c.body_a != kStatic) add_point_velocity(1.0, U[c.body_a].data(), c.r_a, w);
     if (c.body_b != kStatic) add_point_velocity(-1.0, U[c.body_b].data(), c.r_b, w);
@@ -229,7 +230,7 @@ template <bool Isotropic>
       unsettled |= !(std::abs(delta(k)) <= abs_tol + rel_tol * std::abs(updated(k)));
     }
     if (delta.isZero(0.0)) continue;  // Δλ = 0 exactly: the velocities stay as they are
-    double P[3];  // the world percussion F Δλ
+    double P[3];  // the world percussion B ΔΛ
     world_percussion(c, t2, delta, P);
     if (c.body_a != kStatic) {
       apply_percussion<Isotropic>(1.0, M_inv[c.body_a], c.r_a, P, U[c.body_a].data());

@@ -95,6 +95,7 @@ double bouncing_ball_impact_time(int k, double h0, double g, double eps) {
   }
   // EXERCISE 6.6: the impact times of the bouncing ball
   // Hint: the ball leaves impact j with ε^j times the first impact speed √(2 g h₀); each flight
+  //   after it lasts 2 ε^j t₁.
   throw grbd::NotImplemented("Exercise 6.6", "the impact times of the bouncing ball",
                              "Chapter 6: Moreau time-stepping",
                              "exercises/06-moreau-timestepping/midpoint.cpp");

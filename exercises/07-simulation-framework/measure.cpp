@@ -91,7 +91,6 @@ Vector3 contact_force(const contact::CompactContact& contact, const Vector3& Lam
   return (contact.n * Lambda[0] + contact.t1 * Lambda[1] + contact.t2() * Lambda[2]) / dt;
 }
 
-// [slice stresses]
 std::vector<Matrix3> slice_stresses(const Simulation& sim, const Slices& slices) {
   if (!(slices.h > 0.0) || !(slices.area > 0.0)) {
     throw InvalidArgument("slice_stresses: expected h > 0 and area > 0, found h = " +
@@ -110,7 +109,6 @@ std::vector<Matrix3> slice_stresses(const Simulation& sim, const Slices& slices)
                              "Chapter 7: The simulation framework",
                              "exercises/07-simulation-framework/measure.cpp");
 }
-// [slice stresses]
 
 std::vector<double> slice_masses(const Simulation& sim, const Slices& slices) {
   std::vector<double> mass(slices.count, 0.0);
@@ -155,7 +153,6 @@ double fit_janssen_length(std::span<const double> depth, std::span<const double>
 }
 // [janssen fit]
 
-// [steady rate]
 Rate steady_rate(std::span<const double> t, std::span<const double> m, double t_start,
                  std::size_t blocks) {
   require_same_length("steady_rate", t.size(), m.size());
@@ -179,15 +176,13 @@ Rate steady_rate(std::span<const double> t, std::span<const double> m, double t_
   out.blocks = blocks;
   // EXERCISE 7.4: the steady mass flow rate
   // Hint: the rate is the least-squares slope over [first, end); cut [t_first, t_last] into B
-  // Hint: blocks of equal duration, take the slope of each and the standard error of their mean.
+  //   blocks of equal duration, take the slope of each and the standard error of their mean.
   throw grbd::NotImplemented("Exercise 7.4", "the steady mass flow rate",
                              "Chapter 7: The simulation framework",
                              "exercises/07-simulation-framework/measure.cpp");
   return out;
 }
-// [steady rate]
 
-// [beverloo fit]
 BeverlooFit fit_beverloo(std::span<const double> D, std::span<const double> W,
                          std::span<const double> rho_b, double g, double d) {
   require_same_length("fit_beverloo", D.size(), W.size());
@@ -225,7 +220,6 @@ BeverlooFit fit_beverloo(std::span<const double> D, std::span<const double> W,
   fit.rms = std::sqrt(sq / static_cast<double>(D.size()));
   return fit;
 }
-// [beverloo fit]
 
 double beverloo_rate(double C, double k, double rho_b, double g, double D, double d) {
   const double open = D - k * d;

@@ -232,7 +232,7 @@ double RadiusDistribution::quantile(double u) const {
     case Kind::truncated_normal: {
       // EXERCISE 7.1: the truncated normal by inversion
       // Hint: solve Φ(z) = Φ_lo + u (Φ_hi − Φ_lo) with Φ⁻¹(p) = −√2 erfc⁻¹(2p) (Boost.Math); in
-      // Hint: the upper tail phi_lo_ and phi_hi_ hold Q = 1 − Φ instead, and Q⁻¹(p) = √2 erfc⁻¹(2p).
+      //   the upper tail phi_lo_ and phi_hi_ hold Q = 1 − Φ instead, and Q⁻¹(p) = √2 erfc⁻¹(2p).
       throw grbd::NotImplemented("Exercise 7.1", "the truncated normal by inversion",
                                  "Chapter 7: The simulation framework",
                                  "exercises/07-simulation-framework/radius.cpp");
@@ -240,7 +240,7 @@ double RadiusDistribution::quantile(double u) const {
     case Kind::piecewise_constant: {
       // EXERCISE 7.2: the piecewise-constant distribution by inversion
       // Hint: find the interval k with cumulative_[k] ≤ u < cumulative_[k + 1] (skip intervals
-      // Hint: of probability 0), then go linearly from edges_[k] to edges_[k + 1] within it.
+      //   of probability 0), then go linearly from edges_[k] to edges_[k + 1] within it.
       throw grbd::NotImplemented("Exercise 7.2", "the piecewise-constant distribution by inversion",
                                  "Chapter 7: The simulation framework",
                                  "exercises/07-simulation-framework/radius.cpp");

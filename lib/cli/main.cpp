@@ -27,6 +27,7 @@
 #include <cmath>
 #include <csignal>
 #include <cstdio>
+#include <deque>
 #include <filesystem>
 #include <fstream>
 #include <iomanip>
@@ -59,6 +60,21 @@ constexpr const char* kExitCodes =
     "(scene, checkpoint, output or FCLIB file; an output folder that cannot be written; an "
     "existing result without --force), nothing run or changed; 130 / 143 stopped by SIGINT / "
     "SIGTERM after writing a checkpoint (continue with --restart).";
+constexpr const char* kSceneFormat =
+    "The scene format: chapter 7 of the book, section \"Scene files\" (every key, its unit, "
+    "default and range).";
+constexpr const char* kValidateExitCodes =
+    "Exit codes: 0 the scene is valid; 2 bad command line; 3 the scene cannot be read or built "
+    "(the message names file, line and key); 1 out of memory.";
+constexpr const char* kInfoExitCodes =
+    "Exit codes: 0 done; 2 bad command line; 3 not a readable grbd output file.";
+constexpr const char* kFclibExitCodes =
+    "Exit codes: 0 every problem was solved (converged or not: the table says); 1 the CSV could "
+    "not be written; 2 bad command line (also a CSV that is one of the problems); 3 a file the "
+    "FCLIB reader refuses (the files before it were solved, an earlier CSV is left as it was).";
+constexpr const char* kBenchExitCodes =
+    "Exit codes: 0 every program ran; 1 a program failed, or none is built; 2 bad command line, "
+    "or no program matches a name.";
 
 volatile std::sig_atomic_t g_signal = 0;
 
@@ -102,9 +118,19 @@ class Progress {
     const bool last = report.step >= total_;
     if (since < (bar_ ? 0.2 : 10.0) && !last) return;
     last_ = now;
-    const double elapsed = std::chrono::duration<double>(now - start_).count();
-    const double done = static_cast<double>(report.step - first_step_);
-    const double rate = elapsed > 0.0 ? done / elapsed : 0.0;
+    // The rate of the last 30 s, not of the whole run: a pour falls freely at first and slows
+    // down as contacts form, and the ETA follows the present rate.
+    samples_.emplace_back(now, report.step);
+    while (samples_.size() > 2 &&
+           std::chrono::duration<double>(now - samples_[1].first).count() > kWindow) {
+      samples_.pop_front();
+    }
+    const double window = std::chrono::duration<double>(now - samples_.front().first).count();
+    const double since_start = std::chrono::duration<double>(now - start_).count();
+    const double rate =
+        window > 0.0 ? static_cast<double>(report.step - samples_.front().second) / window
+        : since_start > 0.0 ? static_cast<double>(report.step - first_step_) / since_start
+                            : 0.0;
     const double remaining = rate > 0.0 ? static_cast<double>(total_ - report.step) / rate : -1.0;
     const double fraction =
         total_ > 0 ? static_cast<double>(report.step) / static_cast<double>(total_) : 1.0;
@@ -132,9 +158,11 @@ class Progress {
  private:
   bool bar_;
   std::uint64_t total_;
+  static constexpr double kWindow = 30.0;  // [s] of samples the rate is taken over
   bool started_ = false;
   std::uint64_t first_step_ = 0;
   std::chrono::steady_clock::time_point start_, last_;
+  std::deque<std::pair<std::chrono::steady_clock::time_point, std::uint64_t>> samples_;
 };
 
 int run_command(const std::string& scene_file, const std::optional<std::string>& output,
@@ -244,7 +272,12 @@ int info_command(const std::string& file) {
     }
     std::cout << "\n  steps: " << s.steps << ", wall time " << s.seconds << " s\n"
               << "  solver: mean " << s.mean_iterations << " iterations, at most "
-              << s.max_iterations << ", " << s.non_converged << " steps not converged\n"
+              << s.max_iterations << ", " << s.non_converged << " steps not converged";
+    if (s.non_converged > 0) {
+      std::cout << " (they stopped at the cap of " << s.non_converged_iterations
+                << " iterations, [solver] max_iterations, before the tolerance)";
+    }
+    std::cout << "\n"
               << "  contacts: at most " << s.max_contacts << ", largest penetration "
               << s.max_penetration << " m\n";
     return 0;
@@ -408,6 +441,7 @@ int bench_command(const std::vector<std::string>& names, bool list,
 int grbd_main(int argc, char** argv) {
   CLI::App app{"grbd: granular rigid body dynamics — run scenes, inspect their output"};
   app.footer(kExitCodes);
+  app.set_version_flag("--version", std::string("grbd ") + GRBD_VERSION);
   app.require_subcommand(1);
 
   std::string scene_file;
@@ -432,7 +466,7 @@ int grbd_main(int argc, char** argv) {
   run->add_option("--progress", progress,
                   "auto (a bar on a terminal, else a line every 10 s), bar, lines")
       ->check(CLI::IsMember({"auto", "bar", "lines"}));
-  run->footer(kExitCodes);
+  run->footer(std::string(kSceneFormat) + " " + kExitCodes);
 
   std::string validate_file;
   CLI::App* validate =
@@ -440,7 +474,7 @@ int grbd_main(int argc, char** argv) {
   validate->add_option("scene", validate_file, "The scene file (TOML)")
       ->required()
       ->check(CLI::ExistingFile);
-  validate->footer(kExitCodes);
+  validate->footer(std::string(kSceneFormat) + " " + kValidateExitCodes);
 
   std::string info_file;
   CLI::App* info = app.add_subcommand(
@@ -448,7 +482,7 @@ int grbd_main(int argc, char** argv) {
   info->add_option("output", info_file, "The HDF5 output of grbd run")
       ->required()
       ->check(CLI::ExistingFile);
-  info->footer(kExitCodes);
+  info->footer(kInfoExitCodes);
 
   std::vector<std::string> fclib_inputs;
   double fclib_tol = 1e-8;
@@ -471,7 +505,7 @@ int grbd_main(int argc, char** argv) {
                     "At most this many iterations per solver and problem, default 20000")
       ->check(CLI::Range(1, 1 << 30));
   fclib->add_option("--csv", fclib_csv, "Write every iteration's |F|/|q| to this CSV file");
-  fclib->footer(kExitCodes);
+  fclib->footer(kFclibExitCodes);
 
   std::vector<std::string> bench_names;
   bool bench_list = false;
@@ -484,15 +518,32 @@ int grbd_main(int argc, char** argv) {
   bench->footer(
       "Options it does not know, e.g. --benchmark_filter=REGEX or --benchmark_min_time=0.1s, "
       "go to every program it runs. " +
-      std::string(kExitCodes));
+      std::string(kBenchExitCodes));
 
+  // An unknown subcommand is named as such (CLI11 would only say that an argument was not
+  // expected).
+  if (argc > 1 && argv[1][0] != '-') {
+    const std::string word = argv[1];
+    const auto subcommands = app.get_subcommands({});
+    if (std::none_of(subcommands.begin(), subcommands.end(),
+                     [&](const CLI::App* sub) { return sub->get_name() == word; })) {
+      std::cerr << "grbd: unknown subcommand \"" << word
+                << "\"; the subcommands are run, validate, info, fclib and bench (grbd --help)\n";
+      return kExitUsage;
+    }
+  }
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
     return app.exit(e);
+  } catch (const CLI::CallForVersion& e) {
+    return app.exit(e);
   } catch (const CLI::ParseError& e) {
-    const int code = app.exit(e);
-    return code == 0 ? 0 : kExitUsage;
+    // Every error names its subcommand, as the run's own errors do ("grbd run: …").
+    const auto parsed = app.get_subcommands();
+    std::cerr << "grbd" << (parsed.empty() ? "" : " " + parsed.front()->get_name()) << ": "
+              << e.what() << "\nRun with --help for more information.\n";
+    return kExitUsage;
   }
   // Memory that runs out is an error with a message and an exit code, never an abort.
   try {

@@ -96,7 +96,7 @@ double bouncing_ball_impact_time(int k, double h0, double g, double eps) {
   }
   // BEGIN EXERCISE 6.6: the impact times of the bouncing ball
   // Hint: the ball leaves impact j with ε^j times the first impact speed √(2 g h₀); each flight
-  // after it lasts 2 ε^j t₁.
+  //   after it lasts 2 ε^j t₁.
   const double t1 = std::sqrt(2.0 * h0 / g);
   double t = t1;
   double flight = 2.0 * t1;

@@ -230,7 +230,7 @@ double RadiusDistribution::quantile(double u) const {
     case Kind::truncated_normal: {
       // BEGIN EXERCISE 7.1: the truncated normal by inversion
       // Hint: solve Φ(z) = Φ_lo + u (Φ_hi − Φ_lo) with Φ⁻¹(p) = −√2 erfc⁻¹(2p) (Boost.Math); in
-      // Hint: the upper tail phi_lo_ and phi_hi_ hold Q = 1 − Φ instead, and Q⁻¹(p) = √2 erfc⁻¹(2p).
+      //   the upper tail phi_lo_ and phi_hi_ hold Q = 1 − Φ instead, and Q⁻¹(p) = √2 erfc⁻¹(2p).
       const bool tail = (lo_ - mean_) / sd_ > 0.0;
       const double target = phi_lo_ + u * (phi_hi_ - phi_lo_);
       if (!(target > 0.0)) return lo_;
@@ -243,7 +243,7 @@ double RadiusDistribution::quantile(double u) const {
     case Kind::piecewise_constant: {
       // BEGIN EXERCISE 7.2: the piecewise-constant distribution by inversion
       // Hint: find the interval k with cumulative_[k] ≤ u < cumulative_[k + 1] (skip intervals
-      // Hint: of probability 0), then go linearly from edges_[k] to edges_[k + 1] within it.
+      //   of probability 0), then go linearly from edges_[k] to edges_[k + 1] within it.
       std::size_t k = static_cast<std::size_t>(
           std::upper_bound(cumulative_.begin(), cumulative_.end() - 1, u) - cumulative_.begin());
       k = k == 0 ? 0 : k - 1;

@@ -92,12 +92,30 @@ class Scratch(unittest.TestCase):
 
 
 class Help(Scratch):
-    def test_every_subcommand_has_help_with_the_exit_codes(self):
+    def test_every_subcommand_has_help_with_its_own_exit_codes(self):
         for sub in ([], ["run"], ["validate"], ["info"], ["fclib"], ["bench"]):
             result = run(*sub, "--help")
             self.assertEqual(result.returncode, 0, result.stderr)
             self.assertIn("Exit codes", result.stdout)
-            self.assertIn("130", result.stdout)
+            # Only a run can be stopped by a signal.
+            if sub in ([], ["run"]):
+                self.assertIn("130", result.stdout)
+            else:
+                self.assertNotIn("130", result.stdout, sub)
+            if sub in (["run"], ["validate"]):
+                self.assertIn('chapter 7 of the book, section "Scene files"', result.stdout)
+
+    def test_version_unknown_subcommands_and_prefixed_errors(self):
+        result = run("--version")
+        self.assertEqual(result.returncode, 0, result.stderr)
+        self.assertRegex(result.stdout.strip(), r"^grbd \d+\.\d+\.\d+$")
+        result = run("frobnicate")
+        self.assertEqual(result.returncode, 2)
+        self.assertIn('grbd: unknown subcommand "frobnicate"', result.stderr)
+        result = run("run", "nothing.toml")
+        self.assertEqual(result.returncode, 2)
+        self.assertTrue(result.stderr.startswith("grbd run: "), result.stderr)
+        self.assertIn("nothing.toml", result.stderr)
 
 
 class BadCommandLines(Scratch):
@@ -194,6 +212,14 @@ class Output(Scratch):
         result = run("info", out)
         self.assertEqual(result.returncode, 0, result.stderr)
         self.assertIn(f"records: {count}", result.stdout)
+        # Steps that did not converge are explained by the cap they stopped at.
+        with h5py.File(out, "r") as f:
+            steps = f["steps"][()]
+        stopped = steps[steps["converged"] == 0]
+        self.assertGreater(len(stopped), 0)  # the chute's solver is capped at 300 iterations
+        self.assertIn(f"{len(stopped)} steps not converged (they stopped at the cap of "
+                      f"{int(stopped['iterations'].max())} iterations", result.stdout)
+        self.assertEqual(int(stopped["iterations"].max()), 300)
 
     def test_float32_records_on_request(self):
         with open(SCENE) as f:

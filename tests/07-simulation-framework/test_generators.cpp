@@ -105,6 +105,25 @@ count = 7
   }
 }
 
+// A region that holds a whole number of sites holds them all, though the quotient of extent and
+// spacing falls short of it in doubles ((0.18 − 0.1) / 0.004 = 19.999999999999996).
+TEST(Generators, ALatticeCountsItsSitesWithATolerance) {
+  const Scene scene = parse_scene(scene_text(R"(radius = 0.002
+[bodies.generator]
+kind = "lattice"
+region = { min = [0.1, 0, 0], max = [0.18, 0.004, 0.004] }
+spacing = 0.004
+)"),
+                                  "row.toml");
+  volatile double lo = 0.1, hi = 0.18;  // evaluated at run time, as the generator does
+  ASSERT_LT((hi - lo) / 0.004, 20.0);
+  Simulation sim(scene);
+  EXPECT_EQ(sim.system().size(), 20U);
+  const Placement p = check(sim, Vector3(0.1, 0, 0), Vector3(0.18, 0.004, 0.004));
+  EXPECT_TRUE(p.inside);
+  EXPECT_GE(p.min_gap, -1e-15);
+}
+
 TEST(Generators, PackingPlacesEveryBodyWithoutOverlapOrRefusesClearly) {
   const Scene scene =
       parse_scene(scene_text(R"(radius = { distribution = "uniform", min = 0.003, max = 0.006 }

@@ -274,6 +274,38 @@ TEST(SceneFile, ClosestKeyIsTheNearestWithinHalfTheLength) {
   EXPECT_EQ(grbd::scene::closest_key("cout", {"jitter", "spacing", "count"}), "count");
 }
 
+// A half-space faces where its normal points: a rotation or orientation for it is refused with
+// that explanation, not answered with the closest key.
+TEST(SceneFile, AHalfSpaceIsOrientedByItsNormalAlone) {
+  const std::string text = R"([simulation]
+dt = 1e-3
+end_time = 0.01
+[[material]]
+name = "glass"
+[default_contact]
+mu = 0.5
+[[static]]
+shape = "half_space"
+normal = [0, 0, 1]
+rotation = [1, 0, 0, 30]
+material = "glass"
+[[bodies]]
+radius = 0.01
+density = 2500.0
+material = "glass"
+positions = [[0.0, 0.0, 0.05]]
+)";
+  try {
+    parse_scene(text, "plane.toml");
+    ADD_FAILURE() << "a rotated half-space was accepted";
+  } catch (const SceneError& e) {
+    EXPECT_NE(std::string(e.what()).find("plane.toml:11:12: static[0].rotation: expected no "
+                                         "orientation: a half-space is oriented by its normal"),
+              std::string::npos)
+        << e.what();
+  }
+}
+
 // Costs that grow linearly: 10⁵ static objects (each id checked against the others by a hash,
 // not by a scan: a quadratic check took 45 s here) and 1024 materials (the pair table grows by
 // doubling). The test's time limit is what fails when they become quadratic again.

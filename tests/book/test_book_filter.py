@@ -1,4 +1,5 @@
-"""Tests of the book's Doxygen filter (book/book_filter.py): optional sections and figure numbers.
+"""Tests of the book's Doxygen filter (book/book_filter.py): optional sections, figure numbers, and
+snippets that would show an exercise's solution.
 
 The filter resolves `\\if NAME` ... `\\else` ... `\\endif` itself, so that a figure inside a section
 that the build left out takes no number; these tests check that against hand-counted pages.
@@ -6,6 +7,7 @@ that the build left out takes no number; these tests check that against hand-cou
 
 import pathlib
 import sys
+import tempfile
 import unittest
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
@@ -64,6 +66,61 @@ class OptionalSections(unittest.TestCase):
         self.assertIn("BOOK ERROR: an \\if block is not closed by \\endif", unclosed)
         stray = book_filter.filter_chapter(pathlib.Path("chapter.md"), PAGE + "\n\\endif", set())
         self.assertIn("BOOK ERROR: unmatched or malformed '\\endif'", stray)
+
+
+class ExerciseRegions(unittest.TestCase):
+    """No snippet may print the inside of an exercise region: the book would give it away."""
+
+    def page_with(self, snippet):
+        return book_filter.filter_chapter(pathlib.Path("chapter.md"),
+                                          PAGE.split("\n")[0] + "\n\n" + snippet, set())
+
+    def test_a_snippet_that_holds_or_starts_inside_a_region_is_a_book_error(self):
+        folder = tempfile.TemporaryDirectory(prefix="grbd_book_filter_")
+        self.addCleanup(folder.cleanup)
+        source = pathlib.Path(folder.name) / "source.cpp"  # absolute: ROOT / it is itself
+        source.write_text("\n".join([
+            "// [around]", "int f() {", "  // BEGIN EXERCISE 9.1: f", "  return 1;",
+            "  // END EXERCISE 9.1", "}", "// [around]",
+            "// BEGIN EXERCISE 9.2: g", "// [within]", "int g() { return 2; }", "// [within]",
+            "// END EXERCISE 9.2",
+            "// [outside]", "int h();", "// [outside]"]), encoding="utf-8")
+        name = source.as_posix()
+        for tag, exercise in (("around", "9.1"), ("within", "9.2")):
+            out = self.page_with(f"\\snippet {name} {tag}")
+            self.assertIn(f"BOOK ERROR: \\snippet {name} {tag} shows the region of Exercise "
+                          f"{exercise}", out)
+        self.assertNotIn("BOOK ERROR", self.page_with(f"\\snippet {name} outside"))
+
+    def test_no_chapter_shows_an_exercise_region(self):
+        for chapter in sorted(ROOT.glob("chapters/[0-9][0-9]-*/chapter.md")):
+            out = book_filter.filter_chapter(chapter, chapter.read_text(encoding="utf-8"),
+                                             {"paraview"})
+            self.assertNotIn("shows the region of Exercise", out, chapter)
+
+
+class DemoValues(unittest.TestCase):
+    """A number a demo computes reaches the page from the demo's output, never by hand."""
+
+    def test_a_value_is_read_from_the_demos_file_and_a_missing_one_is_a_book_error(self):
+        folder = tempfile.TemporaryDirectory(prefix="grbd_book_values_")
+        self.addCleanup(folder.cleanup)
+        figures = pathlib.Path(folder.name)
+        (figures / "ch07_demo").mkdir()
+        (figures / "ch07_demo" / "values.txt").write_text("pile.iterations = 450\n"
+                                                         "residual = 5.2\\cdot10^{-7}\n")
+        page = PAGE.split("\n")[0] + "\n\n" + "\n".join([
+            "| \\demo{ch07_demo/values.txt#pile.iterations} | \\f$\\demo{ch07_demo/values.txt#residual}\\f$ |",
+            "\\demo{ch07_demo/values.txt#nothing}",
+            "\\demo{ch07_none/values.txt#pile.iterations}"])
+        out = book_filter.filter_chapter(pathlib.Path("chapter.md"), page, set(), figures)
+        lines = out.split("\n")
+        self.assertEqual(lines[2], "| 450 | \\f$5.2\\cdot10^{-7}\\f$ |")
+        self.assertIn("BOOK ERROR: \\demo{ch07_demo/values.txt#nothing}: the demo wrote no value",
+                      lines[3])
+        self.assertIn("BOOK ERROR: \\demo{ch07_none/values.txt#pile.iterations}: no file",
+                      lines[4])
+        self.assertEqual(len(lines[:5]), 5)  # one line out per line in
 
 
 if __name__ == "__main__":

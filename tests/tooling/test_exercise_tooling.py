@@ -1,10 +1,12 @@
 """Tests of the exercise machinery: the stub generator and the grader's classification."""
 
 import contextlib
+import dataclasses
 import importlib.machinery
 import importlib.util
 import io
 import pathlib
+import re
 import stat
 import sys
 import tempfile
@@ -78,6 +80,42 @@ class GeneratorTest(unittest.TestCase):
             with self.subTest(name), self.assertRaises(gx.ExerciseError) as err:
                 self.transform(text)
             self.assertIn(where, str(err.exception))
+
+    def test_a_hint_keeps_its_continuation_lines_and_a_cut_hint_is_refused(self):
+        text = SOLUTION.replace("// Hint: a second hint line.",
+                                "// Hint: a second hint that goes on\n  //   over two lines.")
+        stub, _ = self.transform(text)
+        self.assertIn("  // Hint: a second hint that goes on\n  //   over two lines.\n", stub)
+        cut = SOLUTION.replace("// Hint: a second hint line.",
+                               "// Hint: a second hint that goes on\n  // over two lines.")
+        with self.assertRaises(gx.ExerciseError) as err:
+            self.transform(cut)
+        self.assertIn("indent its continuation", str(err.exception))
+
+    def test_every_stub_keeps_each_hint_whole(self):
+        # The hints of a stub are the solution's, line for line, region by region, and each ends
+        # a sentence: none lost its end to a continuation line the generator dropped.
+        files, _ = gx.generate(ROOT)
+        regions = 0
+        for stub_path, stub_text in files.items():
+            solution = (ROOT / "solutions" / stub_path.relative_to(ROOT / "exercises"))
+            lines = solution.read_text(encoding="utf-8").split("\n")
+            stub = stub_text.split("\n")
+            begins = [k for k, line in enumerate(lines) if gx.BEGIN.match(line)]
+            stubs = [k for k, line in enumerate(stub) if re.match(r"^\s*// EXERCISE \d", line)]
+            self.assertEqual(len(begins), len(stubs), stub_path)
+            for b, e in zip(begins, stubs):
+                given = []
+                for line in lines[b + 1:]:
+                    if not (gx.HINT.match(line) or (given and gx.HINT_CONTINUED.match(line))):
+                        break
+                    given.append(line)
+                self.assertEqual(stub[e + 1:e + 1 + len(given)], given, f"{stub_path}:{e + 1}")
+                for k, line in enumerate(given):
+                    if k + 1 == len(given) or gx.HINT.match(given[k + 1]):
+                        self.assertRegex(line, gx.SENTENCE_END, f"{solution}:{b + 2 + k}")
+                regions += 1
+        self.assertGreater(regions, 40)
 
     def test_repository_exercises_are_generated_from_solutions(self):
         files, exercises = gx.generate(ROOT)
@@ -169,8 +207,10 @@ class GraderTest(unittest.TestCase):
         self.assertLess(time.monotonic() - start, 30.0)
 
     def test_after_three_timeouts_the_rest_is_not_run(self):
+        # 2 s: the fake program is a Python script, whose start alone took more than 0.5 s on a
+        # loaded machine (then it "hangs outside any test" and every test is timed out).
         outcomes, _ = self.run_fake({"A": "hang", "B": "hang", "C": "hang", "D": "pass"},
-                                    timeout=0.5)
+                                    timeout=2.0)
         self.assertEqual(list(outcomes.values()), ["timed out"] * 3 + ["not run"])
 
     def test_the_table_names_stubs_of_other_chapters(self):
@@ -183,6 +223,21 @@ class GraderTest(unittest.TestCase):
             grade.print_table("01-kinematics", exercises, {"Exercise1_1": ["A"]}, results)
         self.assertIn("stops at the stub of Exercise 2.3 (chapter 2)", out.getvalue())
         self.assertIn("--solved 2", out.getvalue())
+
+    def test_the_solved_advice_is_the_closure_at_once(self):
+        # Chapter 6 stopping at stubs of chapters 1 and 4 needs every chapter before it: the
+        # advice must not be --solved 1,4, which would only uncover chapter 5 in the next run.
+        _, flat = self.run_fake({"A": "foreign"})
+        stub = dataclasses.replace(flat["Suite.A"], needs=("1.2", "4.1"))
+        results = {"Exercise6_1": {"Exercise6_1.A": stub}}
+        exercises = [gx.Exercise("6.1", "the midpoint", "06-moreau-timestepping", "f", 1)]
+        out = io.StringIO()
+        with contextlib.redirect_stdout(out):
+            passed = grade.print_table("06-moreau-timestepping", exercises,
+                                       {"Exercise6_1": ["A"]}, results)
+        self.assertIn("scripts/grade 6 --solved 1-5", out.getvalue())
+        self.assertFalse(passed)
+        self.assertEqual(grade.runs([1, 2, 3, 5, 7, 8]), [(1, 3), (5, 5), (7, 8)])
 
     def test_specs_and_solved_chapters_are_parsed(self):
         self.assertEqual(grade.parse_spec("1.3"), ("01-kinematics", "1.3"))

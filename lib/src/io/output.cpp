@@ -538,6 +538,10 @@ OutputSummary read_summary(const std::filesystem::path& path) {
         s.max_iterations, static_cast<std::uint64_t>(std::max(row.iterations, 0)));
     iterations += row.iterations;
     s.non_converged += row.converged ? 0 : 1;
+    if (!row.converged) {
+      s.non_converged_iterations = std::max<std::uint64_t>(
+          s.non_converged_iterations, static_cast<std::uint64_t>(std::max(row.iterations, 0)));
+    }
     s.max_penetration = std::max(s.max_penetration, row.max_penetration);
     s.seconds += row.seconds_total;
   }

@@ -569,6 +569,13 @@ void read_static(TableReader& t, Scene& scene, const std::filesystem::path& fold
   s.pose.I_r = position;
   switch (kind) {
     case 0: {
+      // A half-space has no orientation of its own: its normal says where it faces.
+      for (const char* key : {"rotation", "orientation"}) {
+        if (const toml::node* node = t.get(key)) {
+          t.fail(*node, key,
+                 "no orientation: a half-space is oriented by its normal (key normal)");
+        }
+      }
       const Vector3 normal = t.vector_required("normal");
       if (!(normal.norm() > 0.0)) t.fail(*t.table().get("normal"), "normal", "a non-zero normal");
       const Vector3 n = normal.normalized();

@@ -6,9 +6,9 @@
 ///
 /// The body velocities are u = (I_v_S, I_ω): the angular velocity in the world frame I, not in
 /// the body frame K as in ContactProblem. Then the contact Jacobian of side a with lever arm
-/// I_r_a (from the centre of mass S_a to the contact point) and frame F = [n t1 t2] is
-/// W_a = [F; I_r̃_a F], known from F and r_a alone, and the contact velocity is
-/// γ = Fᵀ (v_a + ω_a × r_a − v_b − ω_b × r_b): one frame product per contact. The price is a
+/// I_r_a (from the centre of mass S_a to the contact point) and frame B = [n t1 t2] is
+/// W_a = [B; I_r̃_a B], known from B and r_a alone, and the contact velocity is
+/// γ = Bᵀ (v_a + ω_a × r_a − v_b − ω_b × r_b): one frame product per contact. The price is a
 /// world-frame inverse inertia I_Θ⁻¹ = A_IK K_Θ⁻¹ A_IKᵀ per body, a full symmetric 3 × 3 matrix
 /// (c·I for a sphere), recomputed when the orientation changes, i.e. once per step.
 
@@ -32,7 +32,7 @@ struct WorldInverseMass {
 /// (1/Θ) I₃, without the rounding of the rotation.
 WorldInverseMass world_inverse_mass(const InverseMass& M_inv, const Matrix3& A_IK);
 
-/// One contact in the compact form. γ = Fᵀ(v_a + ω_a × r_a) − Fᵀ(v_b + ω_b × r_b), F = [n t1 t2]
+/// One contact in the compact form. γ = Bᵀ(v_a + ω_a × r_a) − Bᵀ(v_b + ω_b × r_b), B = [n t1 t2]
 /// with t2 = n × t1; a static side contributes nothing (its lever arm is not read).
 struct CompactContact {
   BodyIndex body_a = kStatic;          ///< body a, or kStatic

@@ -141,6 +141,7 @@ struct OutputSummary {
   double mean_iterations = 0.0;      ///< over the steps
   std::uint64_t max_iterations = 0;  ///< over the steps
   std::uint64_t non_converged = 0;   ///< steps that did not converge
+  std::uint64_t non_converged_iterations = 0;  ///< the iterations they stopped at: the cap
   double max_penetration = 0.0;      ///< over the steps [m]
   double seconds = 0.0;              ///< wall time of the steps [s]
 };

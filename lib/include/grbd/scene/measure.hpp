@@ -34,6 +34,7 @@ double silo_width(const Scene& scene);
 /// Λ = (Λ_N, Λ_T1, Λ_T2): F = (n Λ_N + t1 Λ_T1 + t2 Λ_T2)/Δt [N].
 Vector3 contact_force(const contact::CompactContact& contact, const Vector3& Lambda, double dt);
 
+// [slice stresses declaration]
 /// Love's mean stress of each slice from the contact percussions of the last step:
 /// σ = (1/V) Σ over the bodies whose centres lie in the slice of Σ over their contacts of F ⊗ r,
 /// F the force on the body and r the lever arm from its centre to the contact point (both sides
@@ -41,6 +42,7 @@ Vector3 contact_force(const contact::CompactContact& contact, const Vector3& Lam
 /// negative; the tensor is symmetric in equilibrium. Throws InvalidArgument for h ≤ 0 or
 /// area ≤ 0.
 std::vector<Matrix3> slice_stresses(const Simulation& sim, const Slices& slices);
+// [slice stresses declaration]
 
 /// The mass of the bodies whose centres lie in each slice [kg].
 std::vector<double> slice_masses(const Simulation& sim, const Slices& slices);
@@ -59,6 +61,7 @@ struct Rate {
   std::size_t blocks = 0;  ///< number of blocks the error comes from
 };
 
+// [steady rate declaration]
 /// The steady rate of a cumulative series m(t) (the mass a silo discharged by time t): the
 /// least-squares slope of the points with t ≥ t_start, and as its uncertainty the standard error
 /// σ/√B of the slopes of B consecutive blocks of equal duration (batch means: the increments of a
@@ -67,6 +70,7 @@ struct Rate {
 /// fewer than 2 points per block after t_start.
 Rate steady_rate(std::span<const double> t, std::span<const double> m, double t_start,
                  std::size_t blocks = 5);
+// [steady rate declaration]
 
 /// Beverloo's law fitted to flow rates.
 struct BeverlooFit {
@@ -75,12 +79,14 @@ struct BeverlooFit {
   double rms = 0.0;  ///< root mean square of W_fit/W − 1 over the points
 };
 
+// [beverloo fit declaration]
 /// Beverloo, Leniger and van de Velde (1961): W = C ρ_b √g (D − k d)^(5/2). Fitted, as they did,
 /// on the straight line (W/(ρ_b √g))^(2/5) = C^(2/5) D − C^(2/5) k d by least squares in D; one
 /// bulk density per point. Throws InvalidArgument for series of different lengths, fewer than 2
 /// points, fewer than 2 distinct D, or a rate, density, g or d that is not > 0.
 BeverlooFit fit_beverloo(std::span<const double> D, std::span<const double> W,
                          std::span<const double> rho_b, double g, double d);
+// [beverloo fit declaration]
 
 /// W = C ρ_b √g (D − k d)^(5/2), 0 when D ≤ k d [kg/s].
 double beverloo_rate(double C, double k, double rho_b, double g, double D, double d);
