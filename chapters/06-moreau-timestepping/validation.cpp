@@ -225,6 +225,13 @@ void bouncing_balls(const std::filesystem::path& dir) {
         worst_k = k;
       }
     }
+    const std::string ball = eps == 0.8 ? "ball.eps08." : "ball.eps05.";
+    value((ball + "worst").c_str(), "%.1f", worst);
+    value((ball + "worst_impact").c_str(), "%d", worst_k);
+    value((ball + "zeno").c_str(), "%.4f", t_zeno);
+    value((ball + "rest_from").c_str(), "%.4f", run.rest_from);
+    value((ball + "rest_after_zeno").c_str(), "%.2f", run.rest_from - t_zeno);
+    value((ball + "gain").c_str(), "%s", tex_power(std::max(run.worst_gain, 1e-300)).c_str());
     say("bouncing ball, eps = %.1f: %zu impacts measured; impacts 1-%d within %.2f dt of the "
         "closed form (worst: impact %d); Zeno time %.4f s, at rest (|u| <= 4 eps_mach g dt) from "
         "%.4f s; largest energy gain of one step %.1e of E0\n",
@@ -291,6 +298,12 @@ void inclines(const std::filesystem::path& dir) {
     out << row;
   }
   out.finish();
+  value("incline.below_x", "%s", tex_power(std::abs(below.x)).c_str());
+  value("incline.below_v", "%s", tex_power(worst_below).c_str());
+  value("incline.a", "%.5f", a);
+  value("incline.v_error", "%s", tex_power(worst_above).c_str());
+  value("incline.x_error", "%s",
+        tex_power(std::abs(above.x - 0.5 * a * t_end * t_end) / (0.5 * a * t_end * t_end)).c_str());
   say("block on an incline, mu = %.1f, theta_c = %.4f deg: at theta_c - 0.1 deg after %.0f s "
       "|x| = %.1e m, max |v| = %.1e m/s; at theta_c + 0.1 deg a = g(sin - mu cos) = %.5f m/s^2, "
       "largest relative error of v = a t %.1e, of x = a t^2/2 %.1e\n",
@@ -306,6 +319,13 @@ void inclines(const std::filesystem::path& dir) {
   const double a_roll = 5.0 / 7.0 * kG * std::sin(theta_s);
   const Slide slip = slide(ball, theta_s, 0.95 * mu_roll, t_end, dt);
   const double a_slip = kG * (std::sin(theta_s) - 0.95 * mu_roll * std::cos(theta_s));
+  value("sphere.roll_error", "%s",
+        tex_power(std::abs(roll.v.back() - a_roll * t_end) / (a_roll * t_end)).c_str());
+  value("sphere.roll_slip", "%s",
+        tex_power(std::abs(roll.omega_y * r - roll.v.back()) / roll.v.back()).c_str());
+  value("sphere.slide_error", "%s",
+        tex_power(std::abs(slip.v.back() - a_slip * t_end) / (a_slip * t_end)).c_str());
+  value("sphere.slide_spin", "%.3f", slip.omega_y * r / slip.v.back());
   say("sphere on a 20 deg incline: mu = 1.05 (2/7) tan theta rolls, v(1 s) relative error to "
       "(5/7) g sin theta t %.1e, |omega R - v|/v = %.1e; mu = 0.95 (2/7) tan theta slides, "
       "relative error to g(sin - mu cos) t %.1e, omega R/v = %.3f\n",
@@ -347,6 +367,11 @@ void billiard(const std::filesystem::path& dir) {
     }
   }
   out.finish();
+  value("billiard.t_roll", "%.5f", t_roll);
+  value("billiard.t_star", "%.5f", t_star);
+  value("billiard.steps_late", "%.2f", std::abs(t_roll - t_star) / dt);
+  value("billiard.speed_error", "%s",
+        tex_power(std::abs(system.states()[0].u(0) - 5.0 / 7.0 * v0) / (5.0 / 7.0 * v0)).c_str());
   say("billiard ball, v0 = %.1f m/s, mu = %.1f, dt = %.0e s: rolling from t = %.5f s, "
       "t* = 2 v0/(7 mu g) = %.5f s (error %.2f dt); speed %.12f m/s, (5/7) v0 = %.12f m/s "
       "(relative error %.1e)\n",
@@ -385,6 +410,9 @@ void cradle(const std::filesystem::path& dir) {
         std::snprintf(field, sizeof field, "%s%.4f", i ? ", " : "", v);
         velocities += field;
       }
+      const std::string cradle = "cradle.N" + std::to_string(N) + (eps == 1.0 ? ".eps1." : ".eps0.");
+      value((cradle + "velocities").c_str(), "%s", velocities.c_str());
+      value((cradle + "error").c_str(), "%s", tex_power(worst).c_str());
       say("Newton's cradle, N = %d, eps = %.0f: v/v0 = (%s), largest error to the simultaneous "
           "impact law %.1e\n",
           N, eps, velocities.c_str(), worst);
@@ -439,6 +467,11 @@ void painleve() {
       first = false;
       if (report.contacts > 0) ++with_contact;
     }
+    const std::string key = method == contact::Method::apgd ? "painleve.apgd." : "painleve.sor.";
+    value((key + "capped").c_str(), "%llu",
+          static_cast<unsigned long long>(stepper.non_converged_steps()));
+    value((key + "with_contact").c_str(), "%d", with_contact);
+    value((key + "gain").c_str(), "%s", tex_power(std::max(worst_gain, 1e-300)).c_str());
     say("Painleve rod (mu = 1.5 > 4/3), %s: %llu steps, %d with contact, %llu stopped at "
         "max_iterations; largest energy gain of one step %.1e; state finite: %s\n",
         std::string(contact::method_name(method)).c_str(),
