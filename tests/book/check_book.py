@@ -13,7 +13,8 @@
 - no snippet marker ("[product declaration]") stands in for a function's documentation, and no
   markdown markup (**, `, \\f$) is left unrendered in the text;
 - every exercise heading carries the title of the exercise's marker in solutions/, and the text
-  names its sources (no "the seed lecture").
+  names its sources (no "the seed lecture");
+- the front page and the README's status table agree with which chapters are written.
 
 Usage: check_book.py BUILD/book/html
 """
@@ -167,6 +168,32 @@ def check_exercise_titles(chapter: str, content: str, problems: list[str]) -> No
                             f"solutions/ titles it '{title}'")
 
 
+def check_status(problems: list[str]) -> None:
+    """The book's front page (book/index.md) and the README's status table say which chapters are
+    written: a written chapter is not called an outline or planned there, and a chapter called an
+    outline has no sections yet (else it is written and belongs in WRITTEN)."""
+    index = (ROOT / "book" / "index.md").read_text(encoding="utf-8")
+    readme = (ROOT / "README.md").read_text(encoding="utf-8")
+    for chapter in CHAPTERS:
+        number = int(chapter[2:4])
+        entry = re.search(rf"^{number}\. \\ref {chapter}\b.*(?:\n   .*)*", index, re.M)
+        row = re.search(rf"^\| {number} [^|]*\|[^|]*\|(?P<state>[^|]*)\|", readme, re.M)
+        folder = next(ROOT.glob(f"chapters/{chapter[2:4]}-*/chapter.md"), None)
+        sections = len(re.findall(r"^## ", folder.read_text(encoding="utf-8"), re.M)) \
+            if folder else 0
+        if chapter in WRITTEN:
+            if entry and re.search(r"outline|planned", entry.group(0)):
+                problems.append(f"book/index.md calls the written chapter {chapter} an outline or "
+                                "planned")
+            if row and "outline" in row.group("state"):
+                problems.append(f"README.md's status table calls the written chapter {chapter} an "
+                                "outline")
+        elif sections > 1:
+            problems.append(f"{chapter} has {sections} sections but is treated as an outline: add "
+                            "it to WRITTEN in tests/book/check_book.py (and say so in book/index.md "
+                            "and the README)")
+
+
 def main() -> int:
     html = pathlib.Path(sys.argv[1])
     problems: list[str] = []
@@ -175,6 +202,7 @@ def main() -> int:
         return 1
     check_navigation(html, problems)
     check_mathjax(html, problems)
+    check_status(problems)
 
     markers = snippet_markers()
     pages = sorted(html.glob("*.html"))
