@@ -205,6 +205,15 @@ class Output(Scratch):
                 self.assertLess(np.max(np.abs(norms - 1.0)), 1e-12)
                 self.assertEqual(group["I_r_S"].dtype, np.float64)
                 self.assertEqual(f["records/time"][k], group.attrs["time"])
+                # Every dataset says its unit, and its frame where it has one.
+                for name, unit, frame in (("id", "1", None), ("I_r_S", "m", "I"),
+                                          ("p", "1", "K to I"), ("I_v_S", "m/s", "I"),
+                                          ("K_omega", "rad/s", "K"), ("radius", "m", None)):
+                    self.assertEqual(group[name].attrs["unit"], unit, name)
+                    self.assertEqual(group[name].attrs.get("frame"), frame, name)
+            self.assertEqual(f["records/time"].attrs["unit"], "s")
+            self.assertIn("t: s", f["steps"].attrs["units"])
+            self.assertIn("mass: kg", f["bodies"].attrs["units"])
             last = f["records/%06d" % (count - 1)]
             # Bodies left through the outlet and the inflow added some: both show in the ids.
             self.assertLess(len(last["id"]), len(f["bodies"]))

@@ -204,6 +204,14 @@ std::string read_string(hid_t object, const char* name, const std::string& file)
   return value;
 }
 
+void describe(hid_t location, const char* name, const char* unit, const char* frame,
+              const std::string& file) {
+  Handle dataset = check(H5Dopen2(location, name, H5P_DEFAULT), H5Dclose, file,
+                         std::string("cannot open dataset ") + name);
+  write_attribute(dataset.get(), "unit", std::string(unit), file);
+  if (frame != nullptr) write_attribute(dataset.get(), "frame", std::string(frame), file);
+}
+
 Handle create_table(hid_t location, const char* name, hid_t type, hsize_t chunk,
                     const std::string& file) {
   const hsize_t zero = 0;

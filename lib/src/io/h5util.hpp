@@ -90,6 +90,11 @@ double read_double(hid_t object, const char* name, const std::string& file);
 std::uint64_t read_uint(hid_t object, const char* name, const std::string& file);
 std::string read_string(hid_t object, const char* name, const std::string& file);
 
+/// Gives the dataset `name` of `location` its unit (attribute `unit`, "1" for a pure number) and,
+/// where the values are components in a frame, that frame (attribute `frame`, e.g. "I").
+void describe(hid_t location, const char* name, const char* unit, const char* frame,
+              const std::string& file);
+
 /// An extendable 1-D dataset of `type`, chunked by `chunk` rows.
 Handle create_table(hid_t location, const char* name, hid_t type, hsize_t chunk,
                     const std::string& file);

@@ -201,6 +201,22 @@ OutputFile::OutputFile(const std::filesystem::path& path, const scene::Scene& sc
   o.record_step = h5::create_table(o.records.get(), "step", H5T_STD_U64LE, 256, o.file);
   o.record_bodies = h5::create_table(o.records.get(), "bodies", H5T_STD_U64LE, 256, o.file);
   h5::write_attribute(o.records.get(), "count", std::uint64_t{0}, o.file);
+  h5::describe(o.records.get(), "time", "s", nullptr, o.file);
+  h5::describe(o.records.get(), "step", "1", nullptr, o.file);
+  h5::describe(o.records.get(), "bodies", "1", nullptr, o.file);
+  // A table's columns have their units in one attribute, column by column.
+  h5::write_attribute(o.bodies.get(), "units",
+                      std::string("id: 1; shape: 0 sphere, 1 box, 2 capsule; fixed: 0 or 1; "
+                                  "material: row of /materials; radius: m; half_extents: m "
+                                  "(frame K); half_length: m; mass: kg; K_Theta: kg m^2 "
+                                  "(principal, frame K)"),
+                      o.file);
+  h5::write_attribute(o.steps.get(), "units",
+                      std::string("step: 1; t: s; bodies, contacts, warm_started, iterations: 1; "
+                                  "converged: 0 or 1; residual: natural map (chapter 5); "
+                                  "kinetic_energy, potential_energy: J; max_penetration: m; "
+                                  "seconds_*: s of wall time"),
+                      o.file);
   check(H5Fflush(root, H5F_SCOPE_LOCAL), o.file, "cannot flush");
   write_xdmf();
 }
@@ -382,6 +398,14 @@ void OutputFile::write_record(scene::Simulation& simulation) {
   h5::write_array(group.get(), "I_v_S", real, H5T_NATIVE_DOUBLE, n, 3, o.v.data(), o.file);
   h5::write_array(group.get(), "K_omega", real, H5T_NATIVE_DOUBLE, n, 3, o.w.data(), o.file);
   h5::write_array(group.get(), "radius", real, H5T_NATIVE_DOUBLE, n, 0, o.radius.data(), o.file);
+  // Units and frames: positions and velocities in the inertial frame I, the angular velocity in
+  // the body frame K, p the unit quaternion that turns K-coordinates into I-coordinates.
+  h5::describe(group.get(), "id", "1", nullptr, o.file);
+  h5::describe(group.get(), "I_r_S", "m", "I", o.file);
+  h5::describe(group.get(), "p", "1", "K to I", o.file);
+  h5::describe(group.get(), "I_v_S", "m/s", "I", o.file);
+  h5::describe(group.get(), "K_omega", "rad/s", "K", o.file);
+  h5::describe(group.get(), "radius", "m", nullptr, o.file);
   h5::write_attribute(group.get(), "time", t, o.file);
   h5::write_attribute(group.get(), "step", step, o.file);
   group.close();
