@@ -69,23 +69,12 @@ constexpr double kG = 9.81;
 /// The summary: printed and kept for validation.txt.
 std::string summary;
 
-/// Values the chapter's text quotes (`\demo{ch06_validation/values.txt#KEY}` in chapter.md): one
-/// `key = value` line each, written to values.txt.
-std::string values;
+/// Values the chapter's text quotes (`\demo{ch06_validation/values.txt#KEY}` in chapter.md).
+demo::Values values;
 
-void value(const char* key, const char* format, auto... args) {
-  char text[256];
-  std::snprintf(text, sizeof text, format, args...);
-  values += std::string(key) + " = " + text + "\n";
-}
+void value(const char* key, const char* format, auto... args) { values.set(key, format, args...); }
 
-/// x as TeX, "8.6\cdot10^{-7}", two significant digits.
-std::string tex_power(double x) {
-  const int exponent = static_cast<int>(std::floor(std::log10(x)));
-  char text[64];
-  std::snprintf(text, sizeof text, "%.1f\\cdot10^{%d}", x / std::pow(10.0, exponent), exponent);
-  return text;
-}
+using demo::tex_power;
 
 void say(const char* format, auto... args) {
   char line[512];
@@ -622,9 +611,7 @@ int main(int argc, char** argv) {
     grbd::demo::OutputFile table(dir / "validation.txt");
     table << summary;
     table.finish();
-    grbd::demo::OutputFile quoted(dir / "values.txt");
-    quoted << values;
-    quoted.finish();
+    values.write(dir / "values.txt");
     return 0;
   } catch (...) {
     return grbd::demo::report_exception(kProgram, "Exercises 6.1-6.6");

@@ -14,6 +14,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <iomanip>
 #include <iostream>
@@ -177,6 +178,29 @@ int main(int argc, char** argv) {
     grbd::demo::OutputFile summary(dir / "beverloo.txt");
     summary << text.str();
     summary.finish();
+    // What the chapter quotes (\demo{ch07_beverloo/values.txt#KEY}), per orifice by its diameter
+    // in millimetres.
+    grbd::demo::Values values;
+    double worst = 0.0;
+    for (const auto& r : runs) {
+      char prefix[32];
+      std::snprintf(prefix, sizeof prefix, "D%ld.", std::lround(r.D * 1e3));
+      const std::string key = prefix;
+      const double literature =
+          grbd::scene::beverloo_rate(kLiteratureC, kLiteratureK, r.rho_b, g, r.D, d);
+      values.set(key + "D_over_d", "%.0f", r.D / d);
+      values.set(key + "W", "%.1f", r.W.rate * 1e3);
+      values.set(key + "W_error", "%.1f", r.W.error * 1e3);
+      values.set(key + "rho_b", "%.0f", r.rho_b);
+      values.set(key + "literature", "%.1f", literature * 1e3);
+      values.set(key + "ratio", "%.2f", r.W.rate / literature);
+      worst = std::max(worst, std::abs(r.W.rate / literature - 1.0));
+    }
+    values.set("C", "%.2f", fit.C);
+    values.set("k", "%.2f", fit.k);
+    values.set("rms_percent", "%.1f", fit.rms * 100.0);
+    values.set("worst_percent", "%.0f", worst * 100.0);
+    values.write(dir / "values.txt");
     return 0;
   } catch (...) {
     return grbd::demo::report_exception(kProgram, "the chapter 7 framework");

@@ -13,7 +13,8 @@
 // Checks the balance of the whole fill: the walls and the floor carry its weight.
 //
 // Usage: ch07_janssen <data directory> <scene.toml> [end_time]
-// Writes silo.h5, silo.xmf, silo.ckpt.h5 (the run), janssen.csv (per slice) and janssen.txt.
+// Writes silo.h5, silo.xmf, silo.ckpt.h5 (the run), janssen.csv (per slice), janssen.txt and
+// values.txt (the numbers the chapter quotes).
 
 #include <algorithm>
 #include <cmath>
@@ -187,6 +188,29 @@ int main(int argc, char** argv) {
     grbd::demo::OutputFile summary(dir / "janssen.txt");
     summary << text.str();
     summary.finish();
+    // What the chapter quotes (\demo{ch07_janssen/values.txt#KEY}).
+    grbd::demo::Values values;
+    values.set("balance", "%.3f", a.carried / a.weight);
+    values.set("rho_b", "%.0f", a.rho_b);
+    values.set("packing", "%.2f", a.rho_b / *scene.groups.front().density);
+    values.set("fill_height", "%.1f", a.z_surface * 1e3);
+    values.set("K", "%.3f", a.K);
+    values.set("K_wall", "%.3f", a.K_wall);
+    values.set("mu_mob", "%.3f", a.mu_mob);
+    values.set("mu_w", "%.1f", a.mu_w);
+    values.set("mobilised_percent", "%.0f", 100.0 * a.mu_mob / a.mu_w);
+    values.set("lambda_fit", "%.1f", a.lambda_fit * 1e3);
+    values.set("rms_percent", "%.1f", a.rms * 100.0);
+    values.set("lambda_mob", "%.1f", lambda_mob * 1e3);
+    values.set("ratio_mob", "%.3f", a.lambda_fit / lambda_mob);
+    values.set("agree_mob_percent", "%.1f", 100.0 * std::abs(a.lambda_fit / lambda_mob - 1.0));
+    values.set("lambda_wall", "%.1f", lambda_wall * 1e3);
+    values.set("ratio_wall", "%.2f", a.lambda_fit / lambda_wall);
+    values.set("agree_wall_percent", "%.0f", 100.0 * std::abs(a.lambda_fit / lambda_wall - 1.0));
+    values.set("lambda_w", "%.1f", lambda_w * 1e3);
+    values.set("ratio_w", "%.2f", a.lambda_fit / lambda_w);
+    values.set("ratio_w_short", "%.1f", a.lambda_fit / lambda_w);
+    values.write(dir / "values.txt");
     return 0;
   } catch (...) {
     return grbd::demo::report_exception(kProgram, "the chapter 7 framework");

@@ -166,6 +166,29 @@ int main(int argc, char** argv) {
     grbd::demo::OutputFile summary(dir / "repose.txt");
     summary << text.str();
     summary.finish();
+    // What the chapter quotes (\demo{ch07_repose/values.txt#KEY}), per heap by its μ ("mu0.5.").
+    grbd::demo::Values values;
+    double lo = 90.0, hi = 0.0, at_02 = 0.0, at_1 = 0.0;
+    for (const auto& h : heaps) {
+      char key[32];
+      std::snprintf(key, sizeof key, "mu%g.", h.mu);
+      values.set(std::string(key) + "angle", "%.1f", h.fit.angle);
+      values.set(std::string(key) + "error", "%.1f", h.fit.angle_error);
+      values.set(std::string(key) + "atan", "%.1f", std::atan(h.mu) * 180.0 / M_PI);
+      values.set(std::string(key) + "beads", "%zu", h.beads);
+      values.set(std::string(key) + "rest", "%.2f", h.rest);
+      values.set(std::string(key) + "fastest", "%s", grbd::demo::tex_power(h.max_speed).c_str());
+      if (h.mu >= 0.3) {
+        lo = std::min(lo, h.fit.angle);
+        hi = std::max(hi, h.fit.angle);
+      }
+      if (h.mu == 0.2) at_02 = h.fit.angle;
+      if (h.mu == 1.0) at_1 = h.fit.angle;
+    }
+    values.set("high_mu_low", "%.0f", std::floor(lo));
+    values.set("high_mu_high", "%.0f", std::ceil(hi));
+    values.set("gain_02_1", "%.1f", at_1 - at_02);
+    values.write(dir / "values.txt");
     return 0;
   } catch (...) {
     return grbd::demo::report_exception(kProgram, "the chapter 7 framework");

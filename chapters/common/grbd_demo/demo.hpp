@@ -9,6 +9,7 @@
 
 #include <cerrno>
 #include <cmath>
+#include <cstdio>
 #include <exception>
 #include <filesystem>
 #include <fstream>
@@ -161,6 +162,37 @@ class OutputFile : public std::ofstream {
 /// Call from a `catch (...)` block: prints the exception being handled and returns the demo's exit
 /// code, 3 for grbd::NotImplemented (the student build before the exercises the demo `needs` are
 /// done) and 1 for anything else.
+/// The numbers a chapter quotes from a demo: one `key = value` line each, written to a file
+/// `values.txt` in the demo's figure folder, which the book filter reads when the book is built
+/// (`\demo{FOLDER/values.txt#KEY}` in chapter.md), so that no number is copied by hand.
+class Values {
+ public:
+  /// Adds `key = ` the printf-formatted value.
+  template <class... Args>
+  void set(std::string_view key, const char* format, Args... args) {
+    char text[256];
+    std::snprintf(text, sizeof text, format, args...);
+    text_ += std::string(key) + " = " + text + "\n";
+  }
+  /// Writes them (throws grbd::Error naming the file if it cannot).
+  void write(const std::filesystem::path& file) const {
+    OutputFile out(file);
+    out << text_;
+    out.finish();
+  }
+
+ private:
+  std::string text_;
+};
+
+/// x > 0 as TeX with two significant digits, "8.6\cdot10^{-7}".
+inline std::string tex_power(double x) {
+  const int exponent = static_cast<int>(std::floor(std::log10(x)));
+  char text[64];
+  std::snprintf(text, sizeof text, "%.1f\\cdot10^{%d}", x / std::pow(10.0, exponent), exponent);
+  return text;
+}
+
 inline int report_exception(std::string_view program, std::string_view needs) {
   try {
     throw;
