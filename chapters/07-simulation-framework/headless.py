@@ -11,7 +11,8 @@ wait of guessed length (as with xvfb-run -a); -noreset keeps it from resetting w
 client disconnects, which made one pvbatch in six fail to connect ("bad X server connection")
 on a loaded machine. The command runs with DISPLAY set to that server, which is stopped
 afterwards. A command that fails is tried again, up to 3 times, each with a new server; the exit
-code is the last try's.
+code is the last try's. A command that exits with 2 (bad arguments or input, as
+paraview_spheres.py does for a missing file) is not tried again: its message is what to read.
 """
 
 import os
@@ -76,6 +77,8 @@ def main(argv):
             stop_server(server)
         if code == 0:
             return 0
+        if code == 2:  # the command refused its input or its arguments: a retry cannot help
+            return 2
         sys.stderr.write(f"headless.py: attempt {attempt} of {ATTEMPTS}: {command[0]} exited with "
                          f"{code}\n")
     return code if code != 0 else 1

@@ -14,9 +14,28 @@ started by headless.py beside this script) and Mesa's software renderer (libgl1-
 machine without a display.
 """
 
+import os
+import re
 import sys
 
-from paraview import simple as pv
+
+def missing_input(xmf):
+    """What is wrong with the run to draw, or None: the XDMF file and the HDF5 file it names must
+    be readable (else ParaView prints a reader error per dataset and a traceback)."""
+    if not os.path.isfile(xmf):
+        return f"{xmf}: no such file (the XDMF file beside a grbd output, e.g. build/runs/silo.xmf)"
+    try:
+        with open(xmf, encoding="utf-8") as f:
+            text = f.read()
+    except (OSError, UnicodeDecodeError) as error:
+        return f"{xmf}: cannot read it: {error}"
+    m = re.search(r'Format="HDF">([^:<]+):', text)
+    if m is None:
+        return f"{xmf}: not the XDMF file of a grbd output (no HDF data item)"
+    h5 = os.path.join(os.path.dirname(xmf), m.group(1))
+    if not os.path.isfile(h5):
+        return f"{h5}: no such file (the HDF5 output that {xmf} describes)"
+    return None
 
 
 def main(argv):
@@ -24,6 +43,14 @@ def main(argv):
         sys.stderr.write(__doc__)
         return 2
     xmf, image = argv[1], argv[2]
+    # Checked before ParaView is loaded: a missing input is one message and exit code 2, which
+    # headless.py does not retry.
+    problem = missing_input(xmf)
+    if problem:
+        sys.stderr.write(f"paraview_spheres.py: {problem}\n")
+        return 2
+    from paraview import simple as pv  # noqa: E402 (only once the input is known to be there)
+
     run = pv.XDMFReader(registrationName="run", FileNames=[xmf])
     run.UpdatePipelineInformation()
     times = list(run.TimestepValues) if run.TimestepValues else [0.0]
