@@ -18,6 +18,20 @@ std::string format_number(double x) {
   return std::string(buffer, result.ptr);
 }
 
+std::string regular_file_problem(const std::filesystem::path& path, std::string_view what) {
+  std::error_code error;
+  const auto status = std::filesystem::status(path, error);
+  const std::string name(what);
+  if (!std::filesystem::exists(status)) {
+    if (error && error != std::errc::no_such_file_or_directory) {
+      return "cannot examine the " + name + ": " + error.message();
+    }
+    return "no such " + name;
+  }
+  if (!std::filesystem::is_regular_file(status)) return "is not a regular file, as a " + name + " is";
+  return {};
+}
+
 void require_positive_finite(std::string_view where, std::string_view name, double x) {
   if (!(x > 0.0) || !std::isfinite(x)) {
     std::string message(where);

@@ -12,6 +12,8 @@
 #include <cstring>
 #include <limits>
 
+#include "grbd/core/checks.hpp"
+
 namespace grbd::io::h5 {
 
 Handle string_type(const std::string& file) {
@@ -64,16 +66,8 @@ bool same_constants(const BodyRow& a, const BodyRow& b) {
 }
 
 void require_regular_file(const std::filesystem::path& path, const std::string& what) {
-  std::error_code error;
-  const auto status = std::filesystem::status(path, error);
-  if (!std::filesystem::exists(status)) {
-    if (error && error != std::errc::no_such_file_or_directory) {
-      fail(path.string(), "cannot examine the " + what + ": " + error.message());
-    }
-    fail(path.string(), "no such " + what);
-  }
-  if (!std::filesystem::is_regular_file(status)) {
-    fail(path.string(), "is not a regular file, as a " + what + " is");
+  if (const std::string problem = regular_file_problem(path, what); !problem.empty()) {
+    fail(path.string(), problem);
   }
 }
 

@@ -868,12 +868,10 @@ Scene parse_scene(std::string_view text, const std::filesystem::path& file) {
 
 Scene load_scene(const std::filesystem::path& file) {
   // A FIFO would block and a device never end: only a regular file, of bounded size, is read.
-  std::error_code error;
-  const auto status = std::filesystem::status(file, error);
-  if (!std::filesystem::exists(status)) throw SceneError(file.string() + ": no such scene file");
-  if (!std::filesystem::is_regular_file(status)) {
-    throw SceneError(file.string() + ": is not a regular file (a scene file is one)");
+  if (const std::string problem = regular_file_problem(file, "scene file"); !problem.empty()) {
+    throw SceneError(file.string() + ": " + problem);
   }
+  std::error_code error;
   const std::uintmax_t size = std::filesystem::file_size(file, error);
   if (!error && size > kMaxSceneBytes) {
     throw SceneError(file.string() + ": expected a scene file of at most " +

@@ -14,6 +14,7 @@
 #include <unordered_map>
 
 #include "grbd/body/mass_properties.hpp"
+#include "grbd/body/rigid_body.hpp"
 #include "grbd/collision/narrow_phase.hpp"
 #include "grbd/collision/world.hpp"
 #include "grbd/core/checks.hpp"
@@ -203,10 +204,11 @@ void Simulation::require_invertible_constants() const {
     const BodyGroup& group = scene_.groups[g];
     for (const double r : {group.radius.min(), group.radius.max()}) {
       const BodyConstants c = constants_for(group, r);
-      const auto invertible = [](double x) {
-        return x > 0.0 && std::isfinite(x) && std::isfinite(1.0 / x);
-      };
-      if (invertible(c.inertia.m) && c.inertia.K_Theta.unaryExpr(invertible).all()) continue;
+      try {
+        body::require_valid(c.inertia, "");  // the rule BodySystem::add applies to every body
+        continue;
+      } catch (const InvalidArgument&) {
+      }
       std::ostringstream out;
       out << (group.shape == ShapeKind::box ? "half_extents" : "radius") << ", "
           << (group.density ? "density" : "mass") << ": a body of "
