@@ -19,7 +19,16 @@
 //   expmap_angle_error_rad       the same angle for the exp-map update [rad]
 //
 // The exact rotation is computed with Eigen::AngleAxis, independently of grbd. The program prints
-// a one-line summary. Usage: `ch01_norm_drift <data directory>`.
+// a one-line summary and writes the numbers the chapter quotes to `values.txt` (key = value lines,
+// read by the book at build time: \demo{ch01_norm_drift/values.txt#KEY} in chapter.md):
+//
+//   euler.h<h>.norm, euler.h<h>.scale   |p| of explicit Euler at T and the scale |p|² of the body
+//   euler.h<h>.lag                      its orientation error at T [rad]
+//   expmap.max_norm_deviation           the largest ||p| − 1| of the exp-map update, all h
+//   expmap.drift_per_step               that of h = 0.01 s divided by its number of steps
+//   expmap.max_angle_error              the largest orientation error of the exp-map update [rad]
+//
+// Usage: `ch01_norm_drift <data directory>`.
 
 #include <Eigen/Geometry>
 #include <algorithm>
@@ -66,6 +75,8 @@ struct Result {
   double euler_norm_predicted_end;
   double expmap_max_norm_deviation;
   double expmap_max_angle_error;
+  double euler_angle_error_end;  // [rad]
+  int steps;
 };
 
 // Integrates the spinning body with step h up to `t_end` and writes `file`.
@@ -92,7 +103,7 @@ Result integrate(double h, double t_end, const Vector3& K_omega, const Vector3& 
                              "expmap_angle_error_rad");
   out.precision(17);
 
-  Result result{h, 1.0, 1.0, 0.0, 0.0};
+  Result result{h, 1.0, 1.0, 0.0, 0.0, 0.0, steps};
   for (int n = 0; n <= steps; ++n) {
     if (n > 0) {
       q_euler = kin::explicit_euler_step(q_euler, u, h);
@@ -119,6 +130,7 @@ Result integrate(double h, double t_end, const Vector3& K_omega, const Vector3& 
 
     result.euler_norm_end = euler_norm;
     result.euler_norm_predicted_end = euler_norm_predicted;
+    result.euler_angle_error_end = euler_angle_error;
     result.expmap_max_norm_deviation =
         std::max(result.expmap_max_norm_deviation, std::abs(expmap_norm_minus_one));
     result.expmap_max_angle_error = std::max(result.expmap_max_angle_error, expmap_angle_error);
@@ -139,7 +151,8 @@ std::string step_label(double h) {
 int main(int argc, char** argv) {
   if (const auto exit_code = grbd::demo::check_arguments(
           argc, argv, "ch01_norm_drift", {"<data directory>"},
-          "writes drift_h<h>.csv for h = 0.1, 0.05, 0.01 s into the existing directory")) {
+          "writes drift_h<h>.csv for h = 0.1, 0.05, 0.01 s and values.txt into the existing "
+          "directory")) {
     return *exit_code;
   }
   const std::filesystem::path data_dir = argv[1];
@@ -168,6 +181,26 @@ int main(int argc, char** argv) {
     }
     std::printf(" exp map: max ||p| - 1| = %.1e, max angle error = %.1e rad\n", expmap_norm,
                 expmap_angle);
+
+    // The numbers the chapter quotes.
+    grbd::demo::Values values;
+    for (const Result& r : results) {
+      const std::string h = "euler.h" + step_label(r.h);
+      const double scale = r.euler_norm_end * r.euler_norm_end;
+      values.set(h + ".norm", r.euler_norm_end >= 10.0 ? "%.0f" : "%.2f", r.euler_norm_end);
+      if (scale >= 10.0) {
+        values.set(h + ".scale", "%s", grbd::demo::tex_power(scale).c_str());
+      } else {
+        values.set(h + ".scale", "%.1f", scale);
+      }
+      values.set(h + ".lag", "%.2f", r.euler_angle_error_end);
+    }
+    const Result& finest = results.back();  // h = 0.01 s, the most steps
+    values.set("expmap.max_norm_deviation", "%s", grbd::demo::tex_power(expmap_norm).c_str());
+    values.set("expmap.drift_per_step", "%s",
+               grbd::demo::tex_power(finest.expmap_max_norm_deviation / finest.steps).c_str());
+    values.set("expmap.max_angle_error", "%s", grbd::demo::tex_power(expmap_angle).c_str());
+    values.write(data_dir / "values.txt");
   } catch (...) {
     return grbd::demo::report_exception(
         "ch01_norm_drift",
