@@ -20,6 +20,12 @@
 //   omega.csv   t_s, omega1, omega2, omega3: K_omega [rad/s], every 10 steps
 //   flips.csv   j, t_predicted_s, t_measured_s: the j-th zero of ω2, from the closed form and
 //               measured in the simulation (linear interpolation between steps)
+//   values.txt  the numbers the chapter quotes, key = value lines read by the book at build time
+//               (\demo{ch02_dzhanibekov/values.txt#KEY} in chapter.md): Theta1..3 [1e-4 kg m²],
+//               lambda, sigma (the linear growth rate Ω √((Θ2 − Θ1)(Θ3 − Θ2)/(Θ1 Θ3)) [1/s]),
+//               lambda_sigma (|λ − σ|/σ), one_minus_m, flips, half_period_measured,
+//               half_period_predicted [s], half_period_error (relative), flip_time_error [ms],
+//               energy_error, momentum_error (largest relative errors)
 // and a one-line summary with the measured and predicted half-periods.
 //
 // Usage: `ch02_dzhanibekov <data directory>`.
@@ -95,7 +101,7 @@ Reference reference(const Vector3& Theta, const Vector3& omega) {
 int main(int argc, char** argv) {
   if (const auto exit_code = grbd::demo::check_arguments(
           argc, argv, "ch02_dzhanibekov", {"<data directory>"},
-          "writes omega.csv and flips.csv into the existing directory")) {
+          "writes omega.csv, flips.csv and values.txt into the existing directory")) {
     return *exit_code;
   }
   const std::filesystem::path data_dir = argv[1];
@@ -167,6 +173,30 @@ int main(int argc, char** argv) {
         kEndTime, measured_half_period, ref.half_period,
         std::abs(measured_half_period - ref.half_period) / ref.half_period, max_flip_time_error,
         max_energy_error, max_momentum_error);
+
+    // The numbers the chapter quotes.
+    const Vector3& Theta = rb.K_Theta;
+    const double sigma = Omega * std::sqrt((Theta(1) - Theta(0)) * (Theta(2) - Theta(1)) /
+                                           (Theta(0) * Theta(2)));
+    grbd::demo::Values values;
+    for (int i = 0; i < 3; ++i) {
+      values.set("Theta" + std::to_string(i + 1), "%.3f", 1e4 * Theta(i));
+    }
+    values.set("lambda", "%.3f", ref.lambda);
+    values.set("sigma", "%.3f", sigma);
+    values.set("lambda_sigma", "%s", grbd::demo::tex_power(std::abs(ref.lambda - sigma) / sigma).c_str());
+    values.set("one_minus_m", "%s", grbd::demo::tex_power(1.0 - ref.m).c_str());
+    values.set("flips", "%zu", zeros.size());
+    values.set("half_period_measured", "%.6f", measured_half_period);
+    values.set("half_period_predicted", "%.6f", ref.half_period);
+    values.set("half_period_error", "%s",
+               grbd::demo::tex_power(std::abs(measured_half_period - ref.half_period) /
+                                     ref.half_period)
+                   .c_str());
+    values.set("flip_time_error", "%.2f", 1e3 * max_flip_time_error);
+    values.set("energy_error", "%s", grbd::demo::tex_power(max_energy_error).c_str());
+    values.set("momentum_error", "%s", grbd::demo::tex_power(max_momentum_error).c_str());
+    values.write(data_dir / "values.txt");
   } catch (...) {
     return grbd::demo::report_exception("ch02_dzhanibekov", "the exercises of chapters 1 and 2");
   }

@@ -17,6 +17,13 @@
 // edge length. In the student build, where the mass properties may still be unimplemented
 // exercises, the meshes are written all the same and the comparison is skipped.
 //
+// The comparison's numbers, which the chapter quotes, also go to `values.txt` in the output
+// directory (key = value lines read by the book at build time: \demo{ch02_meshes/values.txt#KEY}
+// in chapter.md, the build's output directory being figures/ch02_meshes): for every mesh, by the
+// file's stem, <stem>.faces, <stem>.volume_error and <stem>.inertia_error (relative errors as TeX,
+// the inertia tensor's in the Frobenius norm), and for the torus the two errors in per cent
+// (space_donut.volume_error_percent, space_donut.inertia_error_percent).
+//
 // Usage: `ch02_make_meshes <output directory>` (the directory is created if needed).
 
 #include <cmath>
@@ -93,6 +100,9 @@ std::vector<NamedMesh> chapter_meshes() {
   };
 }
 
+// x ≥ 0 as TeX with two significant digits ("1.4\cdot10^{-16}"), "0" for an exact zero.
+std::string tex_error(double x) { return x > 0.0 ? grbd::demo::tex_power(x) : std::string("0"); }
+
 // Relative errors of the mesh's volume and inertia tensor against the closed form.
 struct Comparison {
   double volume;
@@ -110,7 +120,8 @@ Comparison compare(const NamedMesh& m) {
 int main(int argc, char** argv) {
   const auto print_usage = [](std::ostream& out) {
     out << "usage: ch02_make_meshes <output directory>\n"
-           "  writes space_donut.obj, box.obj, tetrahedron.obj, icosphere.obj and cylinder.obj\n";
+           "  writes space_donut.obj, box.obj, tetrahedron.obj, icosphere.obj, cylinder.obj and "
+           "values.txt\n";
   };
   if (grbd::demo::wants_help(argc, argv)) {
     print_usage(std::cout);
@@ -139,12 +150,22 @@ int main(int argc, char** argv) {
     std::printf("ch02_make_meshes: wrote %zu meshes to %s;", meshes.size(),
                 out_dir.string().c_str());
     try {
+      grbd::demo::Values values;
       for (const NamedMesh& m : meshes) {
         const Comparison c = compare(m);
         std::printf(" %s: %td faces, rel. error V %.1e, Theta_S %.1e;", m.file.c_str(),
                     static_cast<std::ptrdiff_t>(m.mesh.F.rows()), c.volume, c.inertia);
+        const std::string stem = std::filesystem::path(m.file).stem().string();
+        values.set(stem + ".faces", "%td", static_cast<std::ptrdiff_t>(m.mesh.F.rows()));
+        values.set(stem + ".volume_error", "%s", tex_error(c.volume).c_str());
+        values.set(stem + ".inertia_error", "%s", tex_error(c.inertia).c_str());
+        if (stem == "space_donut") {
+          values.set(stem + ".volume_error_percent", "%.2f", 100.0 * c.volume);
+          values.set(stem + ".inertia_error_percent", "%.2f", 100.0 * c.inertia);
+        }
       }
       std::printf("\n");
+      values.write(out_dir / "values.txt");
     } catch (const grbd::NotImplemented& e) {
       std::printf(" mass properties not compared (%s)\n", e.exercise().c_str());
     }

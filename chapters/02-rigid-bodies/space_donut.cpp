@@ -23,7 +23,16 @@
 // The maxima over each interval keep the envelope of errors that oscillate within one turn, which
 // a plain sample every 250 steps would alias. The exact torque-free solution keeps T and I_L.
 // The program also checks the exact energy law of explicit velocity updates (the chapter's
-// (h²/2) ω̇ᵀ Θ ω̇ per step) on explicit_exp_map and prints a one-line summary.
+// (h²/2) ω̇ᵀ Θ ω̇ per step) on explicit_exp_map and prints a one-line summary. The numbers the
+// chapter quotes go to `values.txt` (key = value lines, read by the book at build time:
+// \demo{ch02_space_donut/values.txt#KEY} in chapter.md): the body (m, Theta1..3, omega, turns),
+// per integrator name the largest relative errors of the energy and of I_L (energy_error,
+// momentum_error) and the share of |I_L| lost by the end (momentum_loss [%]); for explicit_exp_map
+// the final energy over the initial (energy_factor_end) and its largest momentum error as a plain
+// number (momentum_factor); the energy lost by implicit_gyroscopic (energy_loss [%]);
+// explicit_energy_law, the largest relative deviation from the energy law; p_error, the largest
+// ||p| − 1| of all integrators; energy_error_ratio, the largest energy error of explicit_exp_map
+// over that of lie_poisson.
 //
 // Usage: `ch02_space_donut <data directory> <path to space_donut.obj>`.
 
@@ -35,6 +44,7 @@
 #include <iostream>
 #include <numbers>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "grbd/body/integrators.hpp"
@@ -65,6 +75,7 @@ struct Summary {
   double final_energy_error = 0.0;  // signed
   double max_momentum_error = 0.0;
   double max_p_norm_error = 0.0;
+  double final_momentum_length = 1.0;  // |I_L(T)| / |I_L(0)|
 };
 
 // Integrates the torque-free body with `scheme` and writes `file`.
@@ -116,6 +127,7 @@ Summary integrate(const body::RigidBody& rb, const body::State& x0, body::Integr
     s.max_momentum_error = std::max(s.max_momentum_error, momentum);
     s.max_p_norm_error = std::max(s.max_p_norm_error, p_error);
     s.final_energy_error = energy_signed;
+    s.final_momentum_length = body::I_angular_momentum(rb, x).norm() / I_L0.norm();
     if (n % kOutputEvery == 0 || n == steps) {
       out << n * kStep << ',' << window_energy << ',' << window_momentum << ',' << window_p << ','
           << energy_signed << '\n';
@@ -131,7 +143,8 @@ Summary integrate(const body::RigidBody& rb, const body::State& x0, body::Integr
 int main(int argc, char** argv) {
   if (const auto exit_code = grbd::demo::check_arguments(
           argc, argv, "ch02_space_donut", {"<data directory>", "<space_donut.obj>"},
-          "writes <integrator>.csv for every integrator into the existing directory")) {
+          "writes <integrator>.csv for every integrator and values.txt into the existing "
+          "directory")) {
     return *exit_code;
   }
   const std::filesystem::path data_dir = argv[1];
@@ -166,6 +179,41 @@ int main(int argc, char** argv) {
                   s.max_p_norm_error);
     }
     std::printf(" explicit energy law holds to %.1e\n", energy_law_deviation);
+
+    // The numbers the chapter quotes.
+    grbd::demo::Values values;
+    values.set("m", "%.2f", rb.m);
+    for (int i = 0; i < 3; ++i) {
+      values.set("Theta" + std::to_string(i + 1), "%.3f", rb.K_Theta(i));
+    }
+    values.set("omega", "%.2f", K_omega.norm());
+    values.set("turns", "%.0f", K_omega.norm() * kEndTime / (2.0 * kPi));
+    double p_error = 0.0;
+    for (const Summary& s : summaries) {
+      values.set(s.name + ".energy_error", "%s", grbd::demo::tex_power(s.max_energy_error).c_str());
+      values.set(s.name + ".momentum_error", "%s",
+                 grbd::demo::tex_power(s.max_momentum_error).c_str());
+      values.set(s.name + ".momentum_loss", "%.0f", 100.0 * (1.0 - s.final_momentum_length));
+      p_error = std::max(p_error, s.max_p_norm_error);
+    }
+    const auto summary_of = [&](std::string_view name) -> const Summary& {
+      for (const Summary& s : summaries) {
+        if (s.name == name) return s;
+      }
+      throw grbd::Error("no integrator " + std::string(name));
+    };
+    const Summary& explicit_map = summary_of("explicit_exp_map");
+    const Summary& lie_poisson = summary_of("lie_poisson");
+    values.set("explicit_exp_map.momentum_factor", "%.1f", explicit_map.max_momentum_error);
+    values.set("explicit_exp_map.energy_factor_end", "%.1f", 1.0 + explicit_map.final_energy_error);
+    values.set("implicit_gyroscopic.energy_loss", "%.0f",
+               -100.0 * summary_of("implicit_gyroscopic").final_energy_error);
+    values.set("explicit_energy_law", "%s", grbd::demo::tex_power(energy_law_deviation).c_str());
+    values.set("p_error", "%s", grbd::demo::tex_power(p_error).c_str());
+    values.set("energy_error_ratio", "%s",
+               grbd::demo::tex_power(explicit_map.max_energy_error / lie_poisson.max_energy_error)
+                   .c_str());
+    values.write(data_dir / "values.txt");
   } catch (...) {
     return grbd::demo::report_exception("ch02_space_donut", "the exercises of chapters 1 and 2");
   }
