@@ -27,11 +27,18 @@
 //   axis_y    from above) [-]
 //
 // and the nutation band to `nutation_bounds.csv` (columns u_min, u_max). The numbers are
-// printed in one summary line.
+// printed in one summary line, and those the chapter quotes written to `values.txt` (key = value
+// lines read by the book at build time: \demo{ch03_closed_forms/values.txt#KEY} in chapter.md):
+// b5.{bdf,adams,arkode8}.{error,steps}, b5.ratio (the smaller CVODE error over ARKODE's),
+// euler.deviation [rad/s], flip.{predicted [s],zeros,intervals,error (relative)},
+// precession.{predicted [rad/s],error (relative)}, nutation.{u_min,u_max,difference (the largest
+// difference between the measured and the predicted bounds),tilt_max [°],nods (minima of cos ϑ),
+// p_error}, and seconds, the wall time of the whole program.
 //
 // Usage: `ch03_closed_forms <data directory>`.
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <exception>
@@ -191,6 +198,7 @@ struct Nutation {
   ode::NutationBounds predicted;
   ode::NutationBounds measured{1.0, -1.0};
   double max_p_norm_error = 0.0;
+  int nods = 0;  // local minima of u = cos ϑ over the run
 };
 
 Nutation heavy_top(const std::filesystem::path& data_dir) {
@@ -214,9 +222,15 @@ Nutation heavy_top(const std::filesystem::path& data_dir) {
   ode::Cvode cvode(ode::heavy_top(top), 0.0, y0, ode::CvodeMethod::bdf, tolerances);
   cvode.set_projection(ode::quaternion_projection_at(0));
   cvode.set_max_steps(10'000'000);
+  std::vector<double> u_last;  // the last two values of u, to count its minima
   const auto record = [&](double t, const Eigen::VectorXd& y) {
     const kin::Quaternion p(grbd::Vector4(y.head<4>()));
     const Vector3 axis = kin::rotation_matrix(p).col(2);
+    if (u_last.size() == 2 && u_last[1] < u_last[0] && u_last[1] <= axis.z()) {
+      ++nutation.nods;
+    }
+    u_last.push_back(axis.z());
+    if (u_last.size() > 2) u_last.erase(u_last.begin());
     nutation.measured.u_min = std::min(nutation.measured.u_min, axis.z());
     nutation.measured.u_max = std::max(nutation.measured.u_max, axis.z());
     nutation.max_p_norm_error = std::max(nutation.max_p_norm_error, std::abs(p.norm() - 1.0));
@@ -236,11 +250,12 @@ Nutation heavy_top(const std::filesystem::path& data_dir) {
 int main(int argc, char** argv) {
   if (const auto exit_code =
           grbd::demo::check_arguments(argc, argv, "ch03_closed_forms", {"<data directory>"},
-                                      "writes heavy_top.csv and nutation_bounds.csv")) {
+                                      "writes heavy_top.csv, nutation_bounds.csv and values.txt")) {
     return *exit_code;
   }
   const std::filesystem::path data_dir = argv[1];
   try {
+    const auto start = std::chrono::steady_clock::now();
     const std::vector<Detest> b5 = detest_b5();
     const double euler = euler_top_deviation();
     const Flip flip = dzhanibekov();
@@ -267,6 +282,37 @@ int main(int argc, char** argv) {
         "%.1e\n",
         nutation.measured.u_min, nutation.measured.u_max, nutation.predicted.u_min,
         nutation.predicted.u_max, nutation.max_p_norm_error);
+
+    // The numbers the chapter quotes.
+    grbd::demo::Values values;
+    const char* const b5_keys[] = {"b5.bdf", "b5.adams", "b5.arkode8"};  // the order of detest_b5
+    for (std::size_t i = 0; i < b5.size(); ++i) {
+      values.set(std::string(b5_keys[i]) + ".error", "%s", tex_or_zero(b5[i].error).c_str());
+      values.set(std::string(b5_keys[i]) + ".steps", "%ld", b5[i].steps);
+    }
+    values.set("b5.ratio", "%.0f", std::min(b5[0].error, b5[1].error) / b5[2].error);
+    values.set("euler.deviation", "%s", tex_or_zero(euler).c_str());
+    values.set("flip.predicted", "%.7f", flip.predicted);
+    values.set("flip.zeros", "%d", flip.flips);
+    values.set("flip.intervals", "%d", flip.flips - 1);
+    values.set("flip.error", "%s",
+               tex_or_zero(std::abs(flip.measured - flip.predicted) / flip.predicted).c_str());
+    values.set("precession.predicted", "%.9f", precession.predicted);
+    values.set("precession.error", "%s",
+               tex_or_zero(std::abs(precession.measured - precession.predicted) /
+                           precession.predicted)
+                   .c_str());
+    values.set("nutation.u_min", "%.7f", nutation.predicted.u_min);
+    values.set("nutation.u_max", "%.7f", nutation.predicted.u_max);
+    values.set("nutation.difference", "%s",
+               tex_or_zero(std::max(std::abs(nutation.measured.u_min - nutation.predicted.u_min),
+                                    std::abs(nutation.measured.u_max - nutation.predicted.u_max)))
+                   .c_str());
+    values.set("nutation.tilt_max", "%.1f", std::acos(nutation.predicted.u_min) * 180.0 / kPi);
+    values.set("nutation.nods", "%d", nutation.nods);
+    values.set("nutation.p_error", "%s", tex_or_zero(nutation.max_p_norm_error).c_str());
+    values.set("seconds", "%.2f", seconds_since(start));
+    values.write(data_dir / "values.txt");
   } catch (...) {
     return grbd::demo::report_exception("ch03_closed_forms", "the exercises of chapters 1 to 3");
   }

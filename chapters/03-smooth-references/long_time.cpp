@@ -26,7 +26,24 @@
 //   energy_signed_rel_error   (E − E(0)) / E(0) at the end of the window [-]
 //   momentum_signed_rel_error (|L| − |L(0)|) / |L(0)| at the end of the window [-]
 //
-// The final relative errors (and the run times) are printed in one summary line.
+// The final relative errors (and the run times) are printed in one summary line. The numbers the
+// chapter quotes are written to `values.txt` (key = value lines read by the book at build time:
+// \demo{ch03_long_time/values.txt#KEY} in chapter.md):
+//
+//   <method>.energy, .momentum   signed relative errors of E and |L| at the end
+//   <method>.max_energy          the largest relative energy error
+//   <method>.first_energy        the largest relative energy error of the first window (4 turns)
+//   <method>.steps, .seconds     steps, and the run time [s]
+//   explicit_exp_map.doubled, .stopped, .momentum_end
+//                                turns when the energy had doubled and when the run stopped; the
+//                                relative error of |L| then
+//   implicit_gyroscopic.halved   turns until E ≤ E(0)/2
+//   implicit_gyroscopic.final_energy, .steady_spin
+//                                E/E(0) at the end, and a bound (at least 1e-15) on
+//                                |E − L²/(2Θ3)|/E, the distance from a steady spin about axis 3
+//   cvode_{bdf,adams}.crossing   turns after which their energy error exceeds lie_poisson's largest
+//   cvode_{bdf,adams}.time_share lie_poisson's run time over theirs [%]
+//   seconds                      the wall time of the whole program [s]
 //
 // Usage: `ch03_long_time <data directory>`.
 
@@ -38,6 +55,7 @@
 #include <filesystem>
 #include <functional>
 #include <iostream>
+#include <limits>
 #include <numbers>
 #include <string>
 #include <utility>
@@ -79,14 +97,20 @@ struct Summary {
   double max_momentum = 0.0;
   double seconds = 0.0;
   double doubling_time = -1.0;  // first t with E ≥ 2 E(0), if any
+  double halving_time = -1.0;   // first t with E ≤ E(0)/2, if any
+  double crossing_time = -1.0;  // first t with |E − E(0)|/E(0) > the recorder's threshold, if any
+  double first_window_energy = -1.0;  // max |E − E(0)|/E(0) over the first output window
+  long steps = 0;
 };
 
 /// Writes the windows of one run. `next(t)` returns ω at the next sample time t.
 class Recorder {
  public:
+  /// `threshold`: the relative energy error whose first crossing is recorded (crossing_time).
   Recorder(const body::RigidBody& rb, const Vector3& K_omega0, const std::filesystem::path& file,
-           std::string name)
+           std::string name, double threshold = std::numeric_limits<double>::infinity())
       : rb_(rb),
+        threshold_(threshold),
         E0_(energy(rb, K_omega0)),
         L0_(momentum(rb, K_omega0)),
         out_(open_csv(file,
@@ -112,6 +136,12 @@ class Recorder {
     if (summary_.doubling_time < 0.0 && e >= 1.0) {
       summary_.doubling_time = t;
     }
+    if (summary_.halving_time < 0.0 && e <= -0.5) {
+      summary_.halving_time = t;
+    }
+    if (summary_.crossing_time < 0.0 && std::abs(e) > threshold_) {
+      summary_.crossing_time = t;
+    }
     last_ = {t, e, l};
     pending_ = true;
     const bool go_on = std::abs(e) <= kGiveUp;
@@ -136,6 +166,9 @@ class Recorder {
 
  private:
   void end_window() {
+    if (summary_.first_window_energy < 0.0) {
+      summary_.first_window_energy = window_energy_;
+    }
     out_ << last_.t << ',' << last_.t / kTurn << ',' << window_energy_ << ',' << window_momentum_
          << ',' << last_.energy << ',' << last_.momentum << '\n';
     window_energy_ = window_momentum_ = 0.0;
@@ -148,6 +181,7 @@ class Recorder {
     double momentum = 0.0;
   };
   const body::RigidBody& rb_;
+  double threshold_;
   double E0_;
   double L0_;
   grbd::demo::OutputFile out_;
@@ -159,6 +193,18 @@ class Recorder {
   bool pending_ = false;  // samples recorded since the last row
 };
 
+/// x with its sign: "+8.2\cdot10^{-5}" as TeX for |x| < 0.1, "-0.616" with three decimals above.
+std::string signed_value(double x) {
+  if (std::abs(x) >= 0.1) {
+    char text[32];
+    std::snprintf(text, sizeof text, "%+.3f", x);
+    return text;
+  }
+  std::string text = x < 0.0 ? "-" : "+";
+  text += tex_or_zero(std::abs(x));
+  return text;
+}
+
 Summary run_fixed_step(const body::RigidBody& rb, const body::State& x0, body::Integrator scheme,
                        const std::filesystem::path& data_dir) {
   const std::string name(body::integrator_name(scheme));
@@ -167,19 +213,25 @@ Summary run_fixed_step(const body::RigidBody& rb, const body::State& x0, body::I
   const long steps = std::lround(kEndTime / kStep);
   const body::Loads no_loads;
   body::State x = x0;
+  long done = 0;
   for (long n = 1; n <= steps; ++n) {
     x = body::step(rb, x, no_loads, kStep, scheme);
+    done = n;
     if (!recorder.sample(static_cast<double>(n) * kStep, kin::angular_velocity(x.u))) {
       break;
     }
   }
-  return recorder.finish(seconds_since(start));
+  Summary s = recorder.finish(seconds_since(start));
+  s.steps = done;
+  return s;
 }
 
+/// `threshold`: the energy error whose first crossing the summary reports (crossing_time).
 Summary run_cvode(const body::RigidBody& rb, const body::State& x0, ode::CvodeMethod method,
-                  const std::string& name, const std::filesystem::path& data_dir) {
+                  const std::string& name, const std::filesystem::path& data_dir,
+                  double threshold) {
   const auto start = std::chrono::steady_clock::now();
-  Recorder recorder(rb, kin::angular_velocity(x0.u), data_dir / (name + ".csv"), name);
+  Recorder recorder(rb, kin::angular_velocity(x0.u), data_dir / (name + ".csv"), name, threshold);
   ode::Tolerances tolerances;
   tolerances.rtol = kRtol;
   tolerances.atol = 1e-9;
@@ -198,6 +250,7 @@ Summary run_cvode(const body::RigidBody& rb, const body::State& x0, ode::CvodeMe
   Summary s = recorder.finish(seconds_since(start));
   const ode::Statistics stats = cvode.statistics();
   s.name += " (" + std::to_string(stats.steps) + " steps)";
+  s.steps = stats.steps;
   return s;
 }
 
@@ -206,11 +259,12 @@ Summary run_cvode(const body::RigidBody& rb, const body::State& x0, ode::CvodeMe
 int main(int argc, char** argv) {
   if (const auto exit_code = grbd::demo::check_arguments(
           argc, argv, "ch03_long_time", {"<data directory>"},
-          "writes <method>.csv for three integrators of chapter 2 and CVODE")) {
+          "writes <method>.csv for three integrators of chapter 2 and CVODE, and values.txt")) {
     return *exit_code;
   }
   const std::filesystem::path data_dir = argv[1];
   try {
+    const auto start = std::chrono::steady_clock::now();
     const body::RigidBody rb = tumbling_body();
     const double spin = 2.0 * std::numbers::pi * kTurnsPerSecond / std::sqrt(3.0);
     const body::State x0 = tumbling_start(spin);
@@ -221,8 +275,12 @@ int main(int argc, char** argv) {
           body::Integrator::implicit_gyroscopic}) {
       summaries.push_back(run_fixed_step(rb, x0, scheme, data_dir));
     }
-    summaries.push_back(run_cvode(rb, x0, ode::CvodeMethod::bdf, "cvode_bdf", data_dir));
-    summaries.push_back(run_cvode(rb, x0, ode::CvodeMethod::adams, "cvode_adams", data_dir));
+    // When CVODE's drift passes the largest energy error of the Lie–Poisson splitting.
+    const double splitting_error = summaries[1].max_energy;
+    summaries.push_back(
+        run_cvode(rb, x0, ode::CvodeMethod::bdf, "cvode_bdf", data_dir, splitting_error));
+    summaries.push_back(
+        run_cvode(rb, x0, ode::CvodeMethod::adams, "cvode_adams", data_dir, splitting_error));
 
     std::printf(
         "ch03_long_time: |omega| = %.2f rad/s, turn P = %g s, T = %g s = %g turns, "
@@ -239,6 +297,47 @@ int main(int argc, char** argv) {
       std::printf(" [%.2f s];", s.seconds);
     }
     std::printf("\n");
+
+    // The numbers the chapter quotes, under the methods' plain names.
+    const char* const keys[] = {"explicit_exp_map", "lie_poisson", "implicit_gyroscopic",
+                                "cvode_bdf", "cvode_adams"};  // the order of `summaries`
+    grbd::demo::Values values;
+    for (std::size_t i = 0; i < summaries.size(); ++i) {
+      const Summary& s = summaries[i];
+      const std::string key = keys[i];
+      values.set(key + ".energy", "%s", signed_value(s.final_energy).c_str());
+      values.set(key + ".momentum", "%s", signed_value(s.final_momentum).c_str());
+      values.set(key + ".max_energy", "%s", tex_or_zero(s.max_energy).c_str());
+      values.set(key + ".first_energy", "%s", tex_or_zero(s.first_window_energy).c_str());
+      values.set(key + ".steps", "%s", grouped(s.steps).c_str());
+      values.set(key + ".seconds", "%.2f", s.seconds);
+    }
+    const Summary& explicit_map = summaries[0];
+    const Summary& lie_poisson = summaries[1];
+    const Summary& implicit = summaries[2];
+    values.set("explicit_exp_map.doubled", "%.0f", explicit_map.doubling_time / kTurn);
+    values.set("explicit_exp_map.stopped", "%.0f", explicit_map.final_time / kTurn);
+    values.set("explicit_exp_map.momentum_end", "%+.0f", explicit_map.final_momentum);
+    values.set("implicit_gyroscopic.halved", "%.0f", implicit.halving_time / kTurn);
+    values.set("implicit_gyroscopic.final_energy", "%.3f", 1.0 + implicit.final_energy);
+    {
+      // E = L²/(2Θ3) is the energy of a steady spin about the axis of the largest moment.
+      const Vector3 omega0 = kin::angular_velocity(x0.u);
+      const double E = energy(rb, omega0) * (1.0 + implicit.final_energy);
+      const double L = momentum(rb, omega0) * (1.0 + implicit.final_momentum);
+      // A bound, "10^{-15}" below it: round-off may make the difference exactly zero.
+      const double difference = std::abs(E - L * L / (2.0 * rb.K_Theta(2))) / E;
+      values.set("implicit_gyroscopic.steady_spin", "%s",
+                 difference < 1e-15 ? "10^{-15}" : tex_or_zero(difference).c_str());
+    }
+    for (std::size_t i = 3; i < summaries.size(); ++i) {
+      const Summary& s = summaries[i];
+      const std::string key = keys[i];
+      values.set(key + ".crossing", "%.0f", s.crossing_time / kTurn);
+      values.set(key + ".time_share", "%.0f", 100.0 * lie_poisson.seconds / s.seconds);
+    }
+    values.set("seconds", "%.2f", seconds_since(start));
+    values.write(data_dir / "values.txt");
   } catch (...) {
     return grbd::demo::report_exception("ch03_long_time", "the exercises of chapters 1 to 3");
   }

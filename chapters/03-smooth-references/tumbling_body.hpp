@@ -15,6 +15,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <string>
 
@@ -105,6 +106,35 @@ inline grbd::demo::OutputFile open_csv(const std::filesystem::path& file,
   grbd::demo::OutputFile out(file, header);
   out.precision(10);
   return out;
+}
+
+/// x ≥ 0 as TeX with `digits` significant digits ("2.7\cdot10^{-10}" for 2, "2.74\cdot10^{-3}" for
+/// 3), "0" for an exact zero: the form in which values.txt gives the errors the chapter quotes.
+inline std::string tex_or_zero(double x, int digits = 2) {
+  if (!(x > 0.0)) return "0";
+  if (digits == 2) return grbd::demo::tex_power(x);
+  int exponent = static_cast<int>(std::floor(std::log10(x)));
+  double mantissa = x / std::pow(10.0, exponent);
+  const double rounded = std::round(mantissa * std::pow(10.0, digits - 1)) / std::pow(10.0, digits - 1);
+  if (rounded >= 10.0) {  // 9.995 rounds up to 10.0
+    mantissa /= 10.0;
+    ++exponent;
+  }
+  char text[64];
+  std::snprintf(text, sizeof text, "%.*f\\cdot10^{%d}", digits - 1, mantissa, exponent);
+  return text;
+}
+
+/// n with its digits in groups of three from 10 000 on: "465 259", "1780".
+inline std::string grouped(long n) {
+  const std::string digits = std::to_string(n);
+  if (n < 10000) return digits;
+  std::string text;
+  for (std::size_t i = 0; i < digits.size(); ++i) {
+    if (i > 0 && (digits.size() - i) % 3 == 0) text.push_back(' ');
+    text.push_back(digits[i]);
+  }
+  return text;
 }
 
 /// Seconds since `start`.

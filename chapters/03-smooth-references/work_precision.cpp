@@ -31,7 +31,23 @@
 // reference's ω(T) and the closed form of Landau–Lifshitz §37.
 //
 // A summary line names, for the errors 1e-3, 1e-6 and 1e-9 rad, the cheapest method that reached
-// each, by evaluations and by wall time.
+// each, by evaluations and by wall time. The numbers the chapter quotes are written to
+// `values.txt` (key = value lines read by the book at build time:
+// \demo{ch03_work_precision/values.txt#KEY} in chapter.md):
+//
+//   ref.omega_error, ref.cvode_angle  the reference's |ω − closed form| [rad/s] and its angle to
+//                                     the CVODE reference [rad]
+//   e<k>.evaluations, e<k>.time       for the error 10^-k rad (k = 3, 6, 9): the cheapest run by
+//                                     evaluations and by wall time, as "method, parameter: cost"
+//   adams.floor                       the error of CVODE Adams at rtol 1e-10 [rad]
+//   sundials.min_ms                   the shortest SUNDIALS run [ms]
+//   first_order.steps_e3              the fewest steps of a first-order scheme to 1e-3 rad
+//   lie_poisson.steps_e3              the fewest steps of lie_poisson to 1e-3 rad
+//   e3.splitting_over_adaptive        lie_poisson's shortest time to 1e-3 rad over the shortest of
+//                                     the SUNDIALS runs
+//   erk2.best_error, erk2_over_erk8   ARKODE order 2's smallest error, and its evaluations for it
+//                                     over the fewest of order 8 to an error at least as small
+//   seconds                           the wall time of the whole program [s]
 //
 // Usage: `ch03_work_precision <data directory>`.
 
@@ -198,19 +214,31 @@ void write(const Method& method, const std::filesystem::path& data_dir) {
   out.finish();
 }
 
-/// The cheapest run of all methods whose error is at most `target`, by `cost`.
-void print_cheapest(const std::vector<Method>& methods, double target,
-                    const std::function<double(const Run&)>& cost, const char* unit) {
-  const Method* best_method = nullptr;
-  const Run* best = nullptr;
+/// The cheapest run of `methods` whose error is at most `target`, by `cost`, and its method (both
+/// null when none reached it). `which` selects the methods taken into account.
+struct Cheapest {
+  const Method* method = nullptr;
+  const Run* run = nullptr;
+};
+Cheapest cheapest(
+    const std::vector<Method>& methods, double target,
+    const std::function<double(const Run&)>& cost,
+    const std::function<bool(const Method&)>& which = [](const Method&) { return true; }) {
+  Cheapest best;
   for (const Method& m : methods) {
+    if (!which(m)) continue;
     for (const Run& r : m.runs) {
-      if (r.error.angle <= target && (best == nullptr || cost(r) < cost(*best))) {
-        best = &r;
-        best_method = &m;
+      if (r.error.angle <= target && (best.run == nullptr || cost(r) < cost(*best.run))) {
+        best = {&m, &r};
       }
     }
   }
+  return best;
+}
+
+void print_cheapest(const std::vector<Method>& methods, double target,
+                    const std::function<double(const Run&)>& cost, const char* unit) {
+  const auto [best_method, best] = cheapest(methods, target, cost);
   if (best == nullptr) {
     std::printf(" none reached %.0e;", target);
   } else {
@@ -219,13 +247,63 @@ void print_cheapest(const std::vector<Method>& methods, double target,
   }
 }
 
+bool is_sundials(const Method& m) {
+  return m.name.starts_with("cvode") || m.name.starts_with("arkode");
+}
+
+/// How the chapter names a method and its parameter: "(d) Lie–Poisson, \f$h = 50\f$ ms",
+/// "ARKODE order 8, \f$\mathrm{rtol} = 10^{-6.5}\f$".
+std::string run_label(const Method& m, const Run& r) {
+  static const std::pair<const char*, const char*> names[] = {
+      {"explicit_exp_map", "(a) `explicit_exp_map`"},
+      {"symplectic_exp_map", "(b) `symplectic_exp_map`"},
+      {"explicit_euler_normalized", "(c) `explicit_euler_normalized`"},
+      {"lie_poisson", "(d) Lie–Poisson"},
+      {"implicit_gyroscopic", "(e) `implicit_gyroscopic`"},
+      {"cvode_bdf", "CVODE BDF"},
+      {"cvode_adams", "CVODE Adams"},
+      {"arkode_erk2", "ARKODE order 2"},
+      {"arkode_erk4", "ARKODE order 4"},
+      {"arkode_erk8", "ARKODE order 8"}};
+  std::string label = m.name;
+  for (const auto& [name, text] : names) {
+    if (m.name == name) label = text;
+  }
+  char parameter[96];
+  if (is_sundials(m)) {
+    std::snprintf(parameter, sizeof parameter, "\\f$\\mathrm{rtol} = 10^{%g}\\f$",
+                  std::round(2.0 * std::log10(r.parameter)) / 2.0);
+  } else {
+    std::snprintf(parameter, sizeof parameter, "\\f$h = %g\\f$ ms", 1e3 * r.parameter);
+  }
+  return label + ", " + parameter;
+}
+
+/// The cell "method, parameter: cost" of the cheapest run to `target` by `cost`, or "none".
+std::string cheapest_cell(const std::vector<Method>& methods, double target,
+                          const std::function<double(const Run&)>& cost, const char* format) {
+  const auto [method, run] = cheapest(methods, target, cost);
+  if (run == nullptr) return "none";
+  char text[32];
+  std::snprintf(text, sizeof text, format, cost(*run));
+  return run_label(*method, *run) + ": " + text;
+}
+
+/// The method called `name`; throws grbd::Error if there is none.
+const Method& method_named(const std::vector<Method>& methods, const std::string& name) {
+  for (const Method& m : methods) {
+    if (m.name == name) return m;
+  }
+  throw grbd::Error("no method " + name);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   if (const auto exit_code =
           grbd::demo::check_arguments(argc, argv, "ch03_work_precision", {"<data directory>"},
                                       "writes <method>.csv for the integrators of chapter 2, CVODE "
-                                      "and ARKODE")) {
+                                      "and ARKODE, and values.txt")) {
     return *exit_code;
   }
   const std::filesystem::path data_dir = argv[1];
@@ -270,6 +348,60 @@ int main(int argc, char** argv) {
           methods, target, [](const Run& r) { return 1e3 * r.seconds; }, "ms");
     }
     std::printf(" (%.1f s)\n", seconds_since(start));
+
+    // The numbers the chapter quotes.
+    grbd::demo::Values values;
+    values.set("ref.omega_error", "%s", tex_or_zero(ref_vs_closed_form).c_str());
+    values.set("ref.cvode_angle", "%s", tex_or_zero(ref_vs_cvode).c_str());
+    const auto evaluations = [](const Run& r) { return double(r.rhs_evaluations); };
+    const auto milliseconds = [](const Run& r) { return 1e3 * r.seconds; };
+    for (const int k : {3, 6, 9}) {
+      const double target = std::pow(10.0, -k);
+      const std::string key = "e" + std::to_string(k);
+      values.set(key + ".evaluations", "%s",
+                 cheapest_cell(methods, target, evaluations, "%.0f").c_str());
+      values.set(key + ".time", "%s", cheapest_cell(methods, target, milliseconds, "%#.2g ms").c_str());
+    }
+    values.set("adams.floor", "%s",
+               tex_or_zero(method_named(methods, "cvode_adams").runs.back().error.angle).c_str());
+    double sundials_min = std::numeric_limits<double>::infinity();
+    for (const Method& m : methods) {
+      if (!is_sundials(m)) continue;
+      for (const Run& r : m.runs) sundials_min = std::min(sundials_min, r.seconds);
+    }
+    values.set("sundials.min_ms", "%#.2g", 1e3 * sundials_min);
+    const auto steps = [](const Run& r) { return double(r.steps); };
+    const Cheapest first_order = cheapest(methods, 1e-3, steps, [](const Method& m) {
+      return !is_sundials(m) && m.name != "lie_poisson";
+    });
+    const Cheapest splitting_steps =
+        cheapest(methods, 1e-3, steps, [](const Method& m) { return m.name == "lie_poisson"; });
+    const Cheapest splitting_time = cheapest(methods, 1e-3, milliseconds, [](const Method& m) {
+      return m.name == "lie_poisson";
+    });
+    const Cheapest adaptive_time = cheapest(methods, 1e-3, milliseconds, is_sundials);
+    if (first_order.run == nullptr || splitting_steps.run == nullptr ||
+        adaptive_time.run == nullptr) {
+      throw grbd::Error("no first-order, Lie-Poisson or SUNDIALS run reached 1e-3 rad");
+    }
+    values.set("first_order.steps_e3", "%s", grouped(first_order.run->steps).c_str());
+    values.set("lie_poisson.steps_e3", "%ld", splitting_steps.run->steps);
+    values.set("e3.splitting_over_adaptive", "%.1f",
+               splitting_time.run->seconds / adaptive_time.run->seconds);
+    const Method& erk2 = method_named(methods, "arkode_erk2");
+    const Run* erk2_best = &erk2.runs.front();
+    for (const Run& r : erk2.runs) {
+      if (r.error.angle < erk2_best->error.angle) erk2_best = &r;
+    }
+    const Cheapest erk8 = cheapest(methods, erk2_best->error.angle, evaluations,
+                                   [](const Method& m) { return m.name == "arkode_erk8"; });
+    values.set("erk2.best_error", "%s", tex_or_zero(erk2_best->error.angle).c_str());
+    if (erk8.run != nullptr) {
+      values.set("erk2_over_erk8", "%.0f",
+                 double(erk2_best->rhs_evaluations) / double(erk8.run->rhs_evaluations));
+    }
+    values.set("seconds", "%.1f", seconds_since(start));
+    values.write(data_dir / "values.txt");
   } catch (...) {
     return grbd::demo::report_exception("ch03_work_precision", "the exercises of chapters 1 to 3");
   }
