@@ -25,7 +25,14 @@
 //   gamma_T1       first tangential component of γ [m/s]
 //   gamma_T2       second tangential component of γ [m/s]
 //
-// and a one-line summary: the largest |γ_N − ġ_N| over the run.
+// and a one-line summary: the largest |γ_N − ġ_N| over the run. The numbers the chapter quotes go
+// to `values.txt` (key = value lines read by the book at build time:
+// \demo{ch04_contact_velocity/values.txt#KEY} in chapter.md): feature_changes (how often the
+// region changes between samples), dip (the deepest overlap [mm]), dip_from, dip_to (the first and
+// the last sample with g_N < 0 [s]), gamma_min, gamma_max [m/s], median_deviation and
+// away_deviation (the median of |γ_N − ġ_N| and its largest value over the samples whose
+// difference quotient does not straddle a change of region [m/s]), spike, spike_t (the largest
+// value and its time [s]), spike_from, spike_to (the regions at t − δ and t + δ there, in words).
 //
 // Usage: `ch04_contact_velocity <data directory>`.
 
@@ -36,6 +43,7 @@
 #include <filesystem>
 #include <iostream>
 #include <string>
+#include <vector>
 
 #include "grbd/collision/contact.hpp"
 #include "grbd/collision/narrow_phase.hpp"
@@ -93,6 +101,12 @@ int region(double t) {
   return static_cast<int>((C_x.cwiseAbs().array() > kBox.half_extents.array()).count());
 }
 
+// "a face", "an edge", "a vertex" (or "the inside") for a region number.
+const char* region_words(int r) {
+  static const char* const words[] = {"the inside", "a face", "an edge", "a vertex"};
+  return words[r];
+}
+
 void run(const std::filesystem::path& dir) {
   grbd::demo::OutputFile out(dir / "contact_velocity.csv",
                              "t_s,g_N,gamma_N,g_N_dot,region,gamma_T1,gamma_T2");
@@ -102,6 +116,15 @@ void run(const std::filesystem::path& dir) {
   double max_gamma = 0.0;
   double min_gap = 1e300;
   int regions_seen[4] = {0, 0, 0, 0};
+  std::vector<double> deviations;
+  double away_deviation = 0.0;  // largest |γ_N − ġ_N| where [t − δ, t + δ] stays in one region
+  double spike_t = 0.0;
+  int feature_changes = 0;
+  int previous_region = -1;
+  double dip_from = -1.0;
+  double dip_to = -1.0;
+  double min_gamma = 1e300;
+  double max_gamma_signed = -1e300;
   for (int i = 0; i <= kSamples; ++i) {
     const double t = kEndTime * i / kSamples;
     const collision::ContactGeometry g = geometry(t);
@@ -125,7 +148,19 @@ void run(const std::filesystem::path& dir) {
     out << t << ',' << g.g_N << ',' << gamma(0) << ',' << g_N_dot << ',' << r << ',' << gamma(1)
         << ',' << gamma(2) << '\n';
 
-    max_deviation = std::max(max_deviation, std::abs(gamma(0) - g_N_dot));
+    const double deviation = std::abs(gamma(0) - g_N_dot);
+    if (deviation > max_deviation) spike_t = t;
+    deviations.push_back(deviation);
+    if (region(t - kDelta) == region(t + kDelta)) away_deviation = std::max(away_deviation, deviation);
+    if (previous_region >= 0 && r != previous_region) ++feature_changes;
+    previous_region = r;
+    if (g.g_N < 0.0) {
+      if (dip_from < 0.0) dip_from = t;
+      dip_to = t;
+    }
+    min_gamma = std::min(min_gamma, gamma(0));
+    max_gamma_signed = std::max(max_gamma_signed, gamma(0));
+    max_deviation = std::max(max_deviation, deviation);
     max_gamma = std::max(max_gamma, std::abs(gamma(0)));
     min_gap = std::min(min_gap, g.g_N);
     ++regions_seen[r];
@@ -136,6 +171,24 @@ void run(const std::filesystem::path& dir) {
       "min g_N = %.4f m; samples inside/face/edge/vertex region: %d/%d/%d/%d; wrote %s\n",
       max_deviation, max_gamma, min_gap, regions_seen[0], regions_seen[1], regions_seen[2],
       regions_seen[3], out.path().string().c_str());
+
+  // The numbers the chapter quotes.
+  std::sort(deviations.begin(), deviations.end());
+  const double median = deviations[deviations.size() / 2];
+  grbd::demo::Values values;
+  values.set("feature_changes", "%d", feature_changes);
+  values.set("dip", "%.0f", -1e3 * std::min(min_gap, 0.0));
+  values.set("dip_from", "%.2f", dip_from);
+  values.set("dip_to", "%.2f", dip_to);
+  values.set("gamma_min", "%+.2f", min_gamma);
+  values.set("gamma_max", "%+.2f", max_gamma_signed);
+  values.set("median_deviation", "%s", grbd::demo::tex_power(median).c_str());
+  values.set("away_deviation", "%s", grbd::demo::tex_power(away_deviation).c_str());
+  values.set("spike", "%s", grbd::demo::tex_power(max_deviation).c_str());
+  values.set("spike_t", "%.2f", spike_t);
+  values.set("spike_from", "%s", region_words(region(spike_t - kDelta)));
+  values.set("spike_to", "%s", region_words(region(spike_t + kDelta)));
+  values.write(dir / "values.txt");
 }
 
 }  // namespace
@@ -143,7 +196,8 @@ void run(const std::filesystem::path& dir) {
 int main(int argc, char** argv) {
   if (const auto exit_code =
           grbd::demo::check_arguments(argc, argv, "ch04_contact_velocity", {"<data directory>"},
-                                      "writes contact_velocity.csv into the existing directory")) {
+                                      "writes contact_velocity.csv and values.txt into the existing "
+                                      "directory")) {
     return *exit_code;
   }
   try {

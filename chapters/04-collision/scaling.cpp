@@ -32,6 +32,13 @@
 // (The best of the sum is at least the sum of the bests, so the parts add up to a little less than
 // the total.)
 //
+// The numbers the chapter quotes also go to `values.txt` (key = value lines read by the book at
+// build time: \demo{ch04_scaling/values.txt#KEY} in chapter.md): for every N, with the prefix
+// N<N>., pairs (per sphere), cells, random, random_build, morton, morton_build, reordering (the
+// times per sphere of the table, ns) and pass (the best time of one pass in random order, s);
+// for N = 10⁶ spheres_per_cell and half_shell_tests (13.5 cells' worth of spheres, the number of
+// distance tests per sphere).
+//
 // Usage: `ch04_scaling <data directory>`.
 
 #include <algorithm>
@@ -177,6 +184,7 @@ void run(const std::filesystem::path& dir) {
   std::printf("%9s %14s %14s %10s %14s %10s\n", "N", "random ns/body", "morton ns/body",
               "pairs/body", "sort ns/body", "cells");
 
+  grbd::demo::Values values;
   const std::size_t sizes[] = {1'000, 10'000, 100'000, 1'000'000};
   for (const std::size_t n : sizes) {
     const Spheres spheres = random_spheres(n, 20261121 + n);
@@ -209,6 +217,22 @@ void run(const std::filesystem::path& dir) {
         static_cast<long long>(random.cells), repetitions, random.best_build_s * per_body,
         random.best_pairs_s * per_body, morton.best_build_s * per_body,
         morton.best_pairs_s * per_body);
+    std::string key = "N";  // (not "N" + std::to_string(n): GCC 12 warns falsely, -Wrestrict)
+    key += std::to_string(n);
+    key += '.';
+    values.set(key + "pairs", "%.2f", static_cast<double>(random.pairs) / static_cast<double>(n));
+    values.set(key + "cells", "%lld", static_cast<long long>(random.cells));
+    values.set(key + "random", "%.0f", random.best_s * per_body);
+    values.set(key + "random_build", "%.0f", random.best_build_s * per_body);
+    values.set(key + "morton", "%.0f", morton.best_s * per_body);
+    values.set(key + "morton_build", "%.0f", morton.best_build_s * per_body);
+    values.set(key + "reordering", "%.0f", sort_s * per_body);
+    values.set(key + "pass", "%.2g", random.best_s);
+    if (n == 1'000'000) {
+      const double per_cell = static_cast<double>(n) / static_cast<double>(random.cells);
+      values.set("spheres_per_cell", "%.1f", per_cell);
+      values.set("half_shell_tests", "%.0f", 13.5 * per_cell);
+    }
     if (random.pairs != morton.pairs) {
       std::printf("  note: %zu pairs in random order, %zu after reordering\n", random.pairs,
                   morton.pairs);
@@ -226,6 +250,7 @@ void run(const std::filesystem::path& dir) {
     }
   }
   out.finish();
+  values.write(dir / "values.txt");
   std::printf("ch04_scaling: load average %.2f at the end; wrote %s\n", load_average(),
               out.path().string().c_str());
 }
@@ -235,7 +260,7 @@ void run(const std::filesystem::path& dir) {
 int main(int argc, char** argv) {
   if (const auto exit_code =
           grbd::demo::check_arguments(argc, argv, "ch04_scaling", {"<data directory>"},
-                                      "writes scaling.csv into the existing directory")) {
+                                      "writes scaling.csv and values.txt into the existing directory")) {
     return *exit_code;
   }
   try {
