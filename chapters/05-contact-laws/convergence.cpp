@@ -15,6 +15,12 @@
 //   deep.csv         k, SOR, JOR, APGD on the deep frictionless pile
 //   alpha.csv        k, then ‖F‖/‖c‖ of SOR for α = 0.3, 0.6, 1.0, 1.3, 1.6, 1.9 (frictional, cold)
 //   convergence.txt  a table: solver, start, iterations to ‖F‖ ≤ 10⁻⁶ ‖c‖, residuals, time
+//   values.txt       the numbers the chapter quotes, key = value lines read by the book at build
+//                    time (\demo{ch05_convergence/values.txt#KEY} in chapter.md):
+//                    {frictional,deep}.{spheres,contacts}; iterations to the tolerance,
+//                    "> 3000 (residual)" where a solver stopped at the cap, under
+//                    {cold,warm,deep}.{SOR,JOR,APGD} and alpha<α>; the warm start's savings
+//                    cold/warm as factors, saving.{SOR,APGD}; deep.SOR_over_APGD
 //
 // Usage: ch05_convergence <data directory>.
 
@@ -59,6 +65,19 @@ SolverOptions options_for(const std::string& solver) {
   return options;
 }
 
+/// Iterations to the tolerance as the chapter's tables show them: "618", or "> 3000 (2.9e-3)" as
+/// TeX where the solver stopped at the cap with that relative residual.
+std::string iterations_text(const SolverResult& r) {
+  char text[96];
+  if (r.converged) {
+    std::snprintf(text, sizeof text, "%d", r.iterations);
+  } else {
+    std::snprintf(text, sizeof text, "> %d (\\f$%s\\f$)", r.iterations,
+                  grbd::demo::tex_power(r.relative_residual()).c_str());
+  }
+  return text;
+}
+
 SolverResult solve(const std::string& solver, const ContactProblem& problem,
                    ContactSolution& solution, const SolverOptions& options) {
   if (solver == "SOR") return grbd::contact::solve_sor(problem, solution, options);
@@ -94,7 +113,7 @@ void write_columns(const std::filesystem::path& path, const std::vector<std::str
 int main(int argc, char** argv) {
   if (const auto exit_code = grbd::demo::check_arguments(
           argc, argv, kProgram, {"<data directory>"},
-          "writes convergence.csv, deep.csv, alpha.csv and convergence.txt")) {
+          "writes convergence.csv, deep.csv, alpha.csv, convergence.txt and values.txt")) {
     return *exit_code;
   }
   try {
@@ -115,6 +134,9 @@ int main(int argc, char** argv) {
     table << line;
     std::cout << line;
 
+    grbd::demo::Values values;
+    values.set("frictional.spheres", "%zu", pile.problem.M_inv.size());
+    values.set("frictional.contacts", "%zu", pile.problem.contacts.size());
     std::vector<std::string> names;
     std::vector<SolverResult> results;
     for (const bool warm : {false, true}) {
@@ -130,9 +152,14 @@ int main(int argc, char** argv) {
         std::cout << line;
         names.push_back(warm ? solver + "_warm" : solver);
         results.push_back(result);
+        values.set(std::string(warm ? "warm." : "cold.") + solver, "%s",
+                   iterations_text(result).c_str());
       }
     }
     write_columns(dir / "convergence.csv", names, results);
+    // results: SOR, JOR, APGD cold, then warm.
+    values.set("saving.SOR", "%.0f", double(results[0].iterations) / results[3].iterations);
+    values.set("saving.APGD", "%.0f", double(results[2].iterations) / results[5].iterations);
 
     const grbd::demo::SpherePile deep = grbd::demo::sphere_pile(8, 8, 4, 1e-3, 2e-4, 0.0);
     std::vector<SolverResult> deep_results;
@@ -145,7 +172,12 @@ int main(int argc, char** argv) {
       table << line;
       std::cout << line;
       deep_results.push_back(result);
+      values.set("deep." + std::string(solver), "%s", iterations_text(result).c_str());
     }
+    values.set("deep.spheres", "%zu", deep.problem.M_inv.size());
+    values.set("deep.contacts", "%zu", deep.problem.contacts.size());
+    values.set("deep.SOR_over_APGD", "%.0f",
+               double(deep_results[0].iterations) / deep_results[2].iterations);
     write_columns(dir / "deep.csv", {"SOR", "JOR", "APGD"}, deep_results);
 
     std::vector<std::string> alpha_names;
@@ -161,10 +193,13 @@ int main(int argc, char** argv) {
       std::cout << line;
       std::snprintf(line, sizeof line, "alpha=%.1f", alpha);
       alpha_names.emplace_back(line);
+      std::snprintf(line, sizeof line, "alpha%.1f", alpha);
+      values.set(line, "%s", iterations_text(result).c_str());
       alpha_results.push_back(result);
     }
     write_columns(dir / "alpha.csv", alpha_names, alpha_results);
     table.finish();
+    values.write(dir / "values.txt");
     return 0;
   } catch (...) {
     return grbd::demo::report_exception(kProgram, "Exercises 5.1-5.8");

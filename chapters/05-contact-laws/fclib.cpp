@@ -19,6 +19,11 @@
 // Output, in the data directory:
 //   fclib.txt   the table printed to standard output
 //   fclib.csv   problem, solver, k, ‖F‖/‖q‖: every run's history, one row per iteration
+//   values.txt  the table's numbers that the chapter quotes, key = value lines read by the book at
+//               build time (\demo{ch05_fclib/values.txt#KEY} in chapter.md): per problem (the
+//               file's stem) and solver (spaces as '_'), <problem>.<solver>.{contacts,
+//               iterations ("> N" where the solver stopped at the cap), relative (‖F‖/‖q‖),
+//               scaled (‖F‖/max), ms (the wall time)}
 
 #include <CLI/CLI.hpp>
 
@@ -47,7 +52,7 @@ namespace fs = std::filesystem;
 constexpr const char* kProgram = "ch05_fclib";
 constexpr const char* kUsage =
     "usage: ch05_fclib <data directory> <FCLIB file or folder>... [--tol T] [--max-iterations N]\n"
-    "  solves FCLIB problems with SOR, JOR and APGD; writes fclib.txt and fclib.csv\n";
+    "  solves FCLIB problems with SOR, JOR and APGD; writes fclib.txt, fclib.csv and values.txt\n";
 
 /// CLI11's help, which starts with the usage line of the other demos instead of CLI11's own.
 class Help : public CLI::Formatter {
@@ -172,6 +177,7 @@ int main(int argc, char** argv) {
     grbd::demo::OutputFile history(dir / "fclib.csv", "problem,solver,k,relative_residual");
     table << grbd::contact::fclib_table_header();
     std::cout << grbd::contact::fclib_table_header();
+    grbd::demo::Values values;
     grbd::contact::FclibBenchOptions options;
     options.tol = tol;
     options.max_iterations = max_iterations;
@@ -179,6 +185,17 @@ int main(int argc, char** argv) {
     grbd::contact::fclib_bench(files, options, [&](const grbd::contact::FclibBenchRow& row) {
       table << grbd::contact::fclib_table_line(row);
       std::cout << grbd::contact::fclib_table_line(row);
+      std::string key = row.problem;
+      key += '.';
+      for (const char c : row.solver) key += c == ' ' ? '_' : c;
+      key += '.';
+      values.set(key + "contacts", "%zu", row.contacts);
+      values.set(key + "iterations", row.converged ? "%d" : "> %d", row.iterations);
+      // "9.8e-09" as in the table; a residual that stayed large as "2.4".
+      values.set(key + "relative", row.relative_residual >= 0.01 ? "%.2g" : "%.1e",
+                 row.relative_residual);
+      values.set(key + "scaled", "%.1e", row.scaled_residual);
+      values.set(key + "ms", "%.3g", 1e3 * row.seconds);
       char line[512];
       for (std::size_t k = 0; k < row.history.size(); ++k) {
         std::snprintf(line, sizeof line, "%s,%s,%zu,%.6e\n", row.problem.c_str(),
@@ -188,6 +205,7 @@ int main(int argc, char** argv) {
     });
     table.finish();
     history.finish();
+    values.write(dir / "values.txt");
     return 0;
   } catch (...) {
     return grbd::demo::report_exception(kProgram, "Exercises 5.1-5.8");
