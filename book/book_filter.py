@@ -9,6 +9,14 @@ numbers of the source (so Doxygen's warnings still point at the right line):
   solutions/ (`// BEGIN EXERCISE N.M: title`), the single source of every exercise title.
 - Figures `\\image html NAME.svg "caption"` (or NAME.png) are numbered per chapter ("Figure N.k: caption") and
   get the anchor `fig_NAME`; `\\figref{NAME}` in the text becomes a link "Figure N.k".
+- A caption writes its mathematics as the text does, `\\f$\\varepsilon_N\\f$`. Doxygen does not parse
+  formulas in a caption (it warns "Illegal command"), but it copies a caption's text literally,
+  backslashes halved, into the HTML, where MathJax typesets `\\(...\\)` as it does the text's own
+  inline formulas; so the filter writes each `\\f$...\\f$` of a caption as `\\\\(...\\\\)` with every
+  backslash doubled. A plain-text subscript outside the formulas of a caption (a letter or digit,
+  `_` and a letter or digit not followed by a lower-case letter, as in `ε_N`, `A_IK`, `W_aᵀ`,
+  while `find_pairs` is a name; or a Greek letter followed by a digit, `ω2`) is a BOOK ERROR:
+  it belongs in a formula.
 - Optional parts `\\if NAME` ... [`\\else` ...] `\\endif` (lines of their own, outside code
   blocks) are resolved here, against the sections given by `--sections=NAME,...` (which the build
   sets from the tools it found, in place of Doxygen's ENABLED_SECTIONS): the lines of the branch not
@@ -17,14 +25,30 @@ numbers of the source (so Doxygen's warnings still point at the right line):
   `\\demo{FOLDER/values.txt#KEY}` is replaced by the value of `KEY = VALUE` in that file of the
   build's figures folder (`--figures=DIR`); a missing file or key is a BOOK ERROR, never a number
   copied by hand.
+- A table that says it is a demo's output must take its numbers from it. The rule, which sees
+  tables only (in prose a program cannot tell the numbers of a problem's set-up from its results):
+  a markdown table *claims* a demo's output when the text that introduces it (its lines back to
+  the previous heading, figure, table, code block or snippet: CONTEXT_END) names an output file in
+  backticks (`` `convergence.txt` ``, `` `scaling.csv` ``), says "(from `", "the demo measured"
+  (measures, prints, printed, writes, wrote, finds, found), "the demo's output" or "when the book
+  is built" (DEMO_CLAIM). In such a table every body row (not the header) is checked, every cell
+  but the first (which names the row): a cell whose whole text is a literal number (LITERAL_NUMBER:
+  an optional <, >, ≈ or ~, a signed decimal number with digits grouped by spaces or commas, an
+  optional exponent as e-5 or \\cdot10^{-5}, an optional ± part and a parenthesised number, an
+  optional unit, ° or %, in or out of \\f$...\\f$ and **) is a BOOK ERROR, written in place of its
+  row: the number must be a `\\demo{...}`. An introduction that says the table was "measured once"
+  or made "once by hand" (MEASURED_ONCE: a benchmark measured once with a named program) exempts
+  its table.
 - Every chapter gets previous/next links, at the top (in place of the blank line after the title)
   and at the bottom, following the order of the chapter folders; the last chapter leads to the
   bibliography.
 
 Problems (an exercise without a marker in solutions/, a heading that carries its own title, a
 reference to an unknown figure, a `\\snippet` whose lines hold an exercise region's BEGIN or END
-marker, which would print the solution) are written into the page as visible text starting with
-"BOOK ERROR", which the book check (tests/book/check_book.py) refuses, and to stderr.
+marker, which would print the solution, a missing demo value, a table that claims a demo's output
+but holds a number written by hand, a plain-text subscript in a caption) are written into the page
+as visible text starting with "BOOK ERROR", which the book check (tests/book/check_book.py)
+refuses, and to stderr.
 """
 
 from __future__ import annotations
@@ -46,6 +70,27 @@ FENCE = re.compile(r"^\s*(```|~~~)")
 FIGREF = re.compile(r"\\figref\{(?P<name>[\w.-]+)\}")
 DEMO_VALUE = re.compile(r"\\demo\{(?P<file>[\w./-]+)#(?P<key>[\w.-]+)\}")
 SNIPPET = re.compile(r"^\s*\\snippet\s+(?P<file>\S+)\s+(?P<tag>.+?)\s*$")
+FORMULA = re.compile(r"\\f\$(?P<tex>.*?)\\f\$")
+# A plain-text subscript in a caption: "ε_N", "A_IK", "W_aᵀ" (not "find_pairs"), "ω2".
+PLAIN_SUBSCRIPT = re.compile(r"[^\W_]_[^\W_](?![a-z])|[α-ωΑ-Ω][0-9]")
+# What makes the text that introduces a table claim that the table is a demo's output.
+DEMO_CLAIM = re.compile(r"`[\w./-]+\.(?:txt|csv)`|\(from `|\bthe demo (?:measured|measures|prints|"
+                        r"printed|writes|wrote|finds|found)\b|\bthe demo's output\b|"
+                        r"\bwhen the book is built\b", re.I)
+# What exempts it: the table was measured once, by hand (a benchmark).
+MEASURED_ONCE = re.compile(r"\bmeasured once\b|\bonce by hand\b", re.I)
+TABLE_ROW = re.compile(r"^\s*\|")
+# Where the text that introduces a table begins: after a heading, a figure, a table, a code block
+# or a snippet.
+CONTEXT_END = re.compile(r"^\s*(?:#|\||```|~~~|\\image\b|\\snippet\b|\\anchor\b)")
+TABLE_DELIMITER = re.compile(r"^\s*\|?\s*:?-{3,}")
+# A table cell that is nothing but a number (after \f$, \, and ** are removed): "618", "> 3000",
+# "15 700", "2.74\cdot10^{-3} rad", "1.0e-08", "11.2 ± 0.2°", "13.5 ms", "0.022 %",
+# "> 3000 (2.9\cdot10^{-3})".
+_NUMBER = (r"[-+−]?\d[\d ,.]*(?:(?:\\cdot|\\times|×|·)\s*10\^\{?[-+−]?\d+\}?|[eE][-+−]?\d+)?")
+LITERAL_NUMBER = re.compile(rf"^(?:[<>≈~≤≥]\s*)?{_NUMBER}(?:\s*(?:±|\\pm)\s*{_NUMBER})?"
+                            rf"(?:\s*\(\s*{_NUMBER}\s*\))?"
+                            r"\s*(?:%|°|[^\W\d_][^\W\d]*(?:[ /][^\W\d_][^\W\d]*)*)?$")
 EXERCISE_MARKER = re.compile(r"//\s*(?:BEGIN|END) EXERCISE (?P<id>\d+\.\d+)")
 
 
@@ -126,6 +171,72 @@ def demo_values(figures: pathlib.Path | None, file: str) -> dict[str, str] | Non
     return values
 
 
+def caption_html(caption: str) -> str:
+    """A caption as Doxygen must be given it for MathJax to typeset its formulas: each
+    `\\f$TEX\\f$` becomes `\\\\(TEX\\\\)` with every backslash of TEX doubled (Doxygen halves them)."""
+    return FORMULA.sub(lambda m: "\\\\(" + m.group("tex").replace("\\", "\\\\") + "\\\\)", caption)
+
+
+def plain_subscript(caption: str) -> str | None:
+    """The first plain-text subscript outside the formulas of a caption ("ε_N", "ω2"), or None."""
+    m = PLAIN_SUBSCRIPT.search(FORMULA.sub(" ", caption))
+    return m.group(0) if m else None
+
+
+def table_cells(row: str) -> list[str]:
+    """The cells of a markdown table row, split at the bars that are not escaped (`\\|` is the norm
+    bar of a formula)."""
+    cells = re.split(r"(?<!\\)\|", row.strip())
+    if cells and not cells[0].strip():
+        cells = cells[1:]
+    if cells and not cells[-1].strip():
+        cells = cells[:-1]
+    return [cell.strip() for cell in cells]
+
+
+def is_literal_number(cell: str) -> bool:
+    text = cell.replace("\\f$", "").replace("\\,", " ").replace("**", "").strip()
+    return bool(text) and LITERAL_NUMBER.match(text) is not None
+
+
+def demo_table_problems(lines: list[str]) -> dict[int, str]:
+    """{line index: problem} for the rows of the tables that claim a demo's output (DEMO_CLAIM in
+    the text that introduces them) but hold a literal number (see the module's documentation)."""
+    problems: dict[int, str] = {}
+    fenced = False
+    i = 0
+    while i < len(lines):
+        if FENCE.match(lines[i]):
+            fenced = not fenced
+        if fenced or not TABLE_ROW.match(lines[i]):
+            i += 1
+            continue
+        start = i
+        while i < len(lines) and TABLE_ROW.match(lines[i]):
+            i += 1
+        paragraph = []  # the text above the table, back to a heading, figure, table or code
+        above = start - 1
+        while above >= 0 and not CONTEXT_END.match(lines[above]):
+            paragraph.insert(0, lines[above].strip())
+            above -= 1
+        context = " ".join(paragraph)
+        claim = DEMO_CLAIM.search(context)
+        if not claim or MEASURED_ONCE.search(context):
+            continue
+        for row in range(start + 1, i):
+            if TABLE_DELIMITER.match(lines[row]):
+                continue
+            literal = next((cell for cell in table_cells(lines[row])[1:]
+                            if is_literal_number(cell)), None)
+            if literal is not None:
+                problems[row] = (f"the text before this table says it is a demo's output "
+                                 f"('{claim.group(0)}'), but its cell '{literal}' is a number "
+                                 "written by hand: take it from the demo with "
+                                 "\\demo{FOLDER/values.txt#KEY}, or say that the table was "
+                                 "measured once by hand, with which program")
+    return problems
+
+
 def book_error(message: str, path: pathlib.Path, line: int) -> str:
     print(f"{path}:{line}: book_filter: {message}", file=sys.stderr)
     return f"BOOK ERROR: {message}"
@@ -181,8 +292,13 @@ def filter_chapter(path: pathlib.Path, text: str, sections: set[str] | None = No
         if image:
             figures.setdefault(image.group("name"), f"Figure {number}.{len(figures) + 1}")
 
+    tables = demo_table_problems(lines)
+
     out = []
     for i, line in enumerate(lines):
+        if i in tables:
+            out.append(book_error(tables[i], path, i + 1))
+            continue
         heading = EXERCISE.match(line)
         image = IMAGE.match(line)
         snippet = SNIPPET.match(line)
@@ -205,10 +321,16 @@ def filter_chapter(path: pathlib.Path, text: str, sections: set[str] | None = No
                 line = (f"{heading.group('hashes')} Exercise {ex_id}: {titles[ex_id]} "
                         f"{heading.group('anchor')}")
         elif image:
-            name = image.group("name")
-            line = (f'{image.group("indent")}\\anchor {figure_anchor(name)} '
-                    f'\\image html {image.group("file")} '
-                    f'"{figures[name]}: {image.group("caption")}"{image.group("rest")}')
+            name, caption = image.group("name"), image.group("caption")
+            subscript = plain_subscript(caption)
+            if subscript:
+                line = book_error(f"the caption of {image.group('file')} writes the subscript "
+                                  f"'{subscript}' as plain text: write it as a formula, "
+                                  "\\f$...\\f$, as the text does", path, i + 1)
+            else:
+                line = (f'{image.group("indent")}\\anchor {figure_anchor(name)} '
+                        f'\\image html {image.group("file")} '
+                        f'"{figures[name]}: {caption_html(caption)}"{image.group("rest")}')
 
         def figref(ref: re.Match) -> str:
             name = ref.group("name")
