@@ -512,6 +512,7 @@ PileRun settle(bool warm_start, int n, double dt, double t_end, double r) {
   PileRun run;
   run.spheres = system.size();
   while (stepper.time() < t_end - 0.5 * dt) {
+    stepper.reorder_if_due();
     run.reports.push_back(stepper.step());
     run.seconds += run.reports.back().seconds.total;
   }

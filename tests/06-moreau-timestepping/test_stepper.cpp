@@ -453,7 +453,12 @@ TEST(Identity, SameInputGivesBitIdenticalOutputAndReorderingKeepsIt) {
     settings.dt = 1e-3;
     settings.reorder_interval = reorder_interval;
     MoreauStepper stepper(system, statics, materials, settings);
-    for (int step = 0; step < 100; ++step) stepper.step();
+    int reordered = 0;
+    for (int step = 0; step < 100; ++step) {
+      reordered += stepper.reorder_if_due() ? 1 : 0;  // the driver's call, between steps
+      stepper.step();
+    }
+    EXPECT_EQ(reordered, reorder_interval > 0 ? 99 / reorder_interval : 0);
     std::vector<std::pair<GlobalId, body::State>> out;
     for (std::size_t i = 0; i < system.size(); ++i) {
       out.emplace_back(system.ids()[i], system.states()[i]);
@@ -470,6 +475,179 @@ TEST(Identity, SameInputGivesBitIdenticalOutputAndReorderingKeepsIt) {
     ASSERT_EQ(first[i].second.q, reordered[i].second.q);
     ASSERT_EQ(first[i].second.u, reordered[i].second.u);
   }
+}
+
+// ---------------------------------------------------------------------------------------------
+// The hooks of a step (StepHooks): where chapter 8's parallel engine takes part. Each is checked
+// against what the serial step computes without it.
+
+// A pile of 4 × 4 × 4 spheres in an open box, 60 steps: the reference of the hook tests.
+struct PileRun {
+  BodySystem system;
+  StaticGeometry statics;
+  MaterialTable materials = demo::one_material(0.5, 0.2);
+  StepSettings settings;
+  PileRun() {
+    demo::add_open_box(statics, 0.12, 0.12);
+    demo::add_sphere_lattice(system, 4, 4, 4, 0.01, 3);
+    settings.dt = 1e-3;
+    settings.solver.abs_tol = 0.0;  // a criterion that does not change when Λ is scaled
+  }
+};
+
+TEST(StepHooks, AHookThatDoublesEveryMassDoublesThePercussionsAndKeepsTheMotion) {
+  // after_assembly halves every body's inverse mass (what a split body's copy does to its share
+  // of a body): under gravity and contacts alone, doubled masses take doubled percussions and
+  // move exactly as before. Scaling by 2 is exact in binary floating point, so the motion must
+  // agree bit for bit and every percussion be exactly twice the reference's.
+  PileRun plain, hooked;
+  StepHooks hooks;
+  int called = 0;
+  hooks.after_assembly = [&](contact::CompactProblem& problem, contact::ContactSolution&) {
+    for (contact::WorldInverseMass& w : problem.M_inv) {
+      w.inv_m *= 0.5;
+      w.I_Theta_inv *= 0.5;
+    }
+    ++called;
+  };
+  MoreauStepper a(plain.system, plain.statics, plain.materials, plain.settings);
+  MoreauStepper b(hooked.system, hooked.statics, hooked.materials, hooked.settings, hooks);
+  std::size_t contacts = 0;
+  for (int step = 0; step < 60; ++step) {
+    const StepReport ra = a.step();
+    const StepReport rb = b.step();
+    ASSERT_EQ(ra.contacts, rb.contacts) << "step " << step;
+    ASSERT_EQ(ra.iterations, rb.iterations) << "step " << step;
+    for (std::size_t k = 0; k < ra.contacts; ++k) {
+      ASSERT_EQ(b.percussions()[k], 2.0 * a.percussions()[k]) << "step " << step;
+    }
+    contacts += rb.contacts;
+  }
+  EXPECT_EQ(called, 60);
+  EXPECT_GT(contacts, 1000u);
+  for (std::size_t i = 0; i < hooked.system.size(); ++i) {
+    ASSERT_EQ(hooked.system.states()[i].q, plain.system.states()[i].q) << "body " << i;
+    ASSERT_EQ(hooked.system.states()[i].u, plain.system.states()[i].u) << "body " << i;
+  }
+}
+
+TEST(StepHooks, ContactsDroppedAfterDetectionAreNotSolved) {
+  // after_detection removes every contact of body 0 (a process that does not solve them): body 0
+  // then falls freely through its neighbours and the floor, u_z = −g t exactly as for a body
+  // alone, while the hook sees the contacts in canonical order, one key per contact.
+  PileRun run;
+  const GlobalId id = run.system.ids()[0];
+  StepHooks hooks;
+  std::size_t dropped = 0;
+  hooks.after_detection = [&](const BodySystem& system, std::vector<DetectedContact>& contacts,
+                              std::vector<ContactKey>& keys) {
+    EXPECT_EQ(contacts.size(), keys.size());
+    std::size_t kept = 0;
+    for (std::size_t k = 0; k < contacts.size(); ++k) {
+      if (keys[k].a == id || keys[k].b == id) {
+        ++dropped;
+        continue;
+      }
+      contacts[kept] = contacts[k];
+      keys[kept] = keys[k];
+      ++kept;
+    }
+    contacts.resize(kept);
+    keys.resize(kept);
+    (void)system;
+  };
+  MoreauStepper stepper(run.system, run.statics, run.materials, run.settings, hooks);
+  double v = 0.0;
+  for (int step = 0; step < 60; ++step) {
+    stepper.step();
+    v -= kG * run.settings.dt;
+    const std::size_t i = run.system.index_of(id);
+    EXPECT_NEAR(run.system.states()[i].u.z(), v, 1e-12) << "step " << step;
+  }
+  EXPECT_GT(dropped, 0u);
+  for (const ContactKey& key : stepper.keys()) EXPECT_TRUE(key.a != id && key.b != id);
+}
+
+TEST(StepHooks, TheSolverHooksAreReachedAndAVelocityHookKeepsTheResult) {
+  // The solver's own hooks through the step: velocities_between_sweeps runs once per SOR
+  // iteration; one that changes nothing leaves the run bit-identical to a run without hooks,
+  // and reduce_report gets the finished report once per step, last.
+  PileRun plain, hooked;
+  StepHooks hooks;
+  long sweeps = 0;
+  int reports = 0;
+  hooks.solver.velocities_between_sweeps = [&](int, std::span<Vector6> u) {
+    EXPECT_EQ(u.size(), hooked.system.size());
+    ++sweeps;
+  };
+  hooks.reduce_report = [&](StepReport& report) {
+    ++reports;
+    EXPECT_GT(report.seconds.total, 0.0);  // the stages are done and timed
+    report.contacts += 1000;               // what the driver returns is the step's report
+  };
+  MoreauStepper a(plain.system, plain.statics, plain.materials, plain.settings);
+  MoreauStepper b(hooked.system, hooked.statics, hooked.materials, hooked.settings, hooks);
+  long iterations = 0;
+  for (int step = 0; step < 60; ++step) {
+    const StepReport ra = a.step();
+    const StepReport rb = b.step();
+    EXPECT_EQ(rb.contacts, ra.contacts + 1000);
+    EXPECT_EQ(rb.iterations, ra.iterations);
+    iterations += rb.contacts > 1000 ? rb.iterations : 0;
+  }
+  EXPECT_EQ(reports, 60);
+  EXPECT_EQ(sweeps, iterations);
+  EXPECT_GT(sweeps, 60);
+  for (std::size_t i = 0; i < plain.system.size(); ++i) {
+    ASSERT_EQ(hooked.system.states()[i].q, plain.system.states()[i].q);
+    ASSERT_EQ(hooked.system.states()[i].u, plain.system.states()[i].u);
+  }
+  // For JOR and APGD, which recompute u from Λ, a velocity hook is refused by name.
+  StepSettings jor = plain.settings;
+  jor.method = contact::Method::jor;
+  try {
+    MoreauStepper refused(plain.system, plain.statics, plain.materials, jor, hooks);
+    FAIL() << "a velocity hook for JOR was accepted";
+  } catch (const InvalidArgument& e) {
+    EXPECT_NE(std::string(e.what()).find("velocities_between_sweeps is for SOR only"),
+              std::string::npos)
+        << e.what();
+  }
+}
+
+TEST(StepHooks, AHookThatBreaksTheShapeOfTheStepIsAnError) {
+  PileRun run;
+  StepHooks hooks;
+  hooks.after_detection = [](const BodySystem&, std::vector<DetectedContact>& contacts,
+                             std::vector<ContactKey>&) {
+    if (!contacts.empty()) contacts.pop_back();  // keys no longer match
+  };
+  MoreauStepper stepper(run.system, run.statics, run.materials, run.settings, hooks);
+  bool refused = false;
+  for (int step = 0; step < 20 && !refused; ++step) {
+    try {
+      stepper.step();
+    } catch (const InvalidArgument& e) {
+      refused = std::string(e.what()).find("one key per contact") != std::string::npos;
+    }
+  }
+  EXPECT_TRUE(refused);
+}
+
+TEST(StepHooks, TheActiveSetToleranceIsFixedOnceWhateverBodiesArePresent) {
+  // Without tolerance_radius the smallest bounding radius of the first bodies, kept when smaller
+  // bodies arrive later; with it, the settings' length from the start.
+  PileRun run;
+  const double r = run.system.bounding_radii()[0];
+  MoreauStepper stepper(run.system, run.statics, run.materials, run.settings);
+  EXPECT_EQ(stepper.active_set_tolerance(), run.settings.contact_tolerance * r);
+  run.system.add(sphere_body(9999, 0.25 * r, Vector3(0.0, 0.0, 0.2)));
+  stepper.step();
+  EXPECT_EQ(stepper.active_set_tolerance(), run.settings.contact_tolerance * r);
+  StepSettings given = run.settings;
+  given.tolerance_radius = 0.1 * r;
+  MoreauStepper fixed(run.system, run.statics, run.materials, given);
+  EXPECT_EQ(fixed.active_set_tolerance(), given.contact_tolerance * 0.1 * r);
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -247,8 +247,22 @@ class Output(Scratch):
         out = self.reference()
         xmf = out[:-3] + ".xmf"
         tree = ET.parse(xmf)
-        grids = tree.findall(".//Grid[@GridType='Uniform']")
+        grids = tree.findall(".//Grid[@GridType='Collection']/Grid[@GridType='Uniform']")
         with h5py.File(out, "r") as f:
+            # The static geometry: one grid of triangles outside the records, on /static.
+            static = tree.findall("./Domain/Grid[@Name='static']")
+            self.assertEqual(len(static), 1)
+            triangles = f["static/triangles"][()]
+            points = f["static/points"][()]
+            self.assertEqual(int(static[0].find("Topology").get("NumberOfElements")),
+                             len(triangles))
+            self.assertEqual([i.text.split(":", 1)[1] for i in static[0].iter("DataItem")],
+                             ["/static/triangles", "/static/points", "/static/object"])
+            self.assertEqual(triangles.max(), len(points) - 1)
+            self.assertEqual(list(f["static/names"].asstr()), ["slope", "left wall", "right wall"])
+            self.assertEqual(list(f["static/shape"]), [3, 3, 3])  # half-spaces
+            self.assertEqual(f["static/points"].attrs["unit"], "m")
+            self.assertEqual(sorted(set(f["static/object"])), [0, 1, 2])
             count = int(f["records"].attrs["count"])
             # Records without bodies have no grid (ParaView cannot show an empty one).
             with_bodies = [k for k in range(count) if f["records/bodies"][k] > 0]

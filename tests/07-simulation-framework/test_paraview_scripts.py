@@ -1,5 +1,6 @@
 #!/usr/bin/env python3
-"""Chapter 7: the ParaView helper scripts refuse a missing input at once, without ParaView.
+"""Chapter 7: the ParaView helper scripts refuse a missing input at once, without ParaView, and
+frame any run.
 
 Run by CTest as `test_paraview_scripts.py`. paraview_spheres.py checks the XDMF file and the HDF5
 file it names before it loads ParaView, and exits with 2 and one message; headless.py does not try
@@ -72,6 +73,43 @@ class Scripts(unittest.TestCase):
                                 timeout=120)
         self.assertEqual(result.returncode, 1)
         self.assertIn("attempt 3 of 3", result.stderr)
+
+
+class Framing(unittest.TestCase):
+    """paraview_spheres.frame() shows any run whole, beside the colour bar's strip: the image
+    takes the data's shape, and every corner of the data's box projects into the data's part."""
+
+    def corners_in_picture(self, bounds):
+        sys.path.insert(0, FOLDER)
+        import paraview_spheres as ps
+        size, (position, focal, up, scale) = ps.frame(bounds)
+        back = [p - f for p, f in zip(position, focal)]
+        n = sum(b * b for b in back) ** 0.5
+        back = [b / n for b in back]
+        right = [up[1] * back[2] - up[2] * back[1], up[2] * back[0] - up[0] * back[2],
+                 up[0] * back[1] - up[1] * back[0]]
+        metres_per_pixel = 2.0 * scale / size[1]
+        for x in bounds[0:2]:
+            for y in bounds[2:4]:
+                for z in bounds[4:6]:
+                    d = [x - focal[0], y - focal[1], z - focal[2]]
+                    px = size[0] / 2 + sum(a * b for a, b in zip(right, d)) / metres_per_pixel
+                    py = size[1] / 2 + sum(a * b for a, b in zip(up, d)) / metres_per_pixel
+                    self.assertGreaterEqual(px, 0.0)
+                    self.assertLessEqual(px, size[0] - ps.BAR_STRIP)  # never under the bar
+                    self.assertGreaterEqual(py, 0.0)
+                    self.assertLessEqual(py, size[1])
+        return size
+
+    def test_a_silo_is_tall_and_a_chute_wide_and_both_whole(self):
+        silo = self.corners_in_picture([-0.015, 0.015, -0.015, 0.015, 0.0, 0.26])
+        self.assertGreater(silo[1], silo[0])
+        chute = self.corners_in_picture([-0.1, 0.9, -0.1, 0.1, -0.05, 0.4])
+        self.assertGreater(chute[0], chute[1])
+        cube = self.corners_in_picture([5.0, 6.0, 5.0, 6.0, 5.0, 6.0])  # away from the origin
+        self.assertGreater(cube[0], 0)
+        flat = self.corners_in_picture([0.0, 1.0, 0.0, 1.0, 0.0, 0.0])  # a floor alone
+        self.assertGreater(flat[0], flat[1])
 
 
 if __name__ == "__main__":

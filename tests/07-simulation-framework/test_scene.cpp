@@ -85,6 +85,30 @@ TEST(SceneFile, AMinimalSceneTakesTheDocumentedDefaults) {
   EXPECT_NEAR(simulation.system().inertia()[0].m, 2500.0 * 4.0 / 3.0 * M_PI * 1e-6, 1e-15);
 }
 
+TEST(SceneFile, TheActiveSetToleranceScalesTheSmallestRadiusAnyGroupCanProduce) {
+  // chapter 7's test chute: beads of radius uniform in [4, 6] mm from a lattice and an inflow,
+  // removed at an outlet; the tolerance must not follow the smallest bead present.
+  const Scene chute = grbd::scene::load_scene(std::filesystem::path(GRBD_CH07_DATA_DIR) /
+                                              "chute.toml");
+  EXPECT_EQ(chute.settings.tolerance_radius, 0.004);
+  // A box's bounding radius is |h|, a capsule's r + l; the smallest over the groups counts.
+  std::string text = replace(kMinimal, "radius = 0.01", "radius = 2.0");
+  EXPECT_EQ(parse_scene(text, "x.toml").settings.tolerance_radius, 2.0);
+  text += "[[bodies]]\nname = \"bricks\"\nshape = \"box\"\nhalf_extents = [0.3, 0.4, 1.2]\n"
+          "density = 1000.0\nmaterial = \"glass\"\npositions = [[5.0, 0.0, 2.0]]\n"
+          "[[bodies]]\nname = \"rods\"\nshape = \"capsule\"\nradius = 0.5\n"
+          "half_length = 0.9\ndensity = 1000.0\nmaterial = \"glass\"\n"
+          "positions = [[9.0, 0.0, 2.0]]\n";
+  EXPECT_DOUBLE_EQ(parse_scene(text, "x.toml").settings.tolerance_radius, 1.3);
+  text = replace(text, "half_length = 0.9", "half_length = 0.7");  // now the capsule: 1.2
+  EXPECT_DOUBLE_EQ(parse_scene(text, "x.toml").settings.tolerance_radius, 1.2);
+  grbd::scene::Simulation simulation(chute);
+  const double tolerance = simulation.stepper().active_set_tolerance();
+  EXPECT_EQ(tolerance, chute.settings.contact_tolerance * 0.004);
+  for (int step = 0; step < 200; ++step) simulation.step();  // inflow and outlet at work
+  EXPECT_EQ(simulation.stepper().active_set_tolerance(), tolerance);
+}
+
 TEST(SceneFile, UnknownKeysAreErrorsWithTheClosestKnownKey) {
   EXPECT_EQ(error_of(replace(kMinimal, "end_time", "end_tme")),
             "scene.toml:3:1: simulation.end_tme: unknown key (did you mean \"end_time\"?)");

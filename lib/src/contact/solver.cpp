@@ -922,6 +922,8 @@ void iterate(Model& model, Policy& policy, Monitor<Model>& monitor, const Solver
       hooks.after_iteration(k, model.lambda(), model.u());
       model.touched();
     }
+    // Only u changes: the sweep's own tests of Λ still hold (no touched()).
+    if (hooks.velocities_between_sweeps) hooks.velocities_between_sweeps(k, model.u());
     const Verdict verdict = monitor.after(k);
     IterationStatus local = IterationStatus::running;
     if (verdict == Verdict::diverged) {
@@ -1103,6 +1105,11 @@ ContactSolver::ContactSolver(Method method, SolverOptions options, SolverHooks h
       workspace_(std::make_unique<Workspace>()) {
   validate_method(method_, "ContactSolver");
   validate_options(options_, "ContactSolver");
+  if (hooks_.velocities_between_sweeps && method_ != Method::sor) {
+    throw InvalidArgument(std::string("ContactSolver: the hook velocities_between_sweeps is for "
+                                      "SOR only; ") + std::string(method_name(method_)) +
+                          " recomputes u from the percussions and would drop its change");
+  }
 }
 
 ContactSolver::~ContactSolver() = default;
@@ -1148,6 +1155,10 @@ SolverResult ContactSolver::solve_prepared(const CompactProblem& problem,
 }
 
 SolverResult ContactSolver::solve(const LocalProblem& problem, std::vector<Vector3>& lambda) {
+  if (hooks_.velocities_between_sweeps) {
+    throw InvalidArgument("ContactSolver::solve: the hook velocities_between_sweeps needs body "
+                          "velocities, which the local form (FCLIB) does not have");
+  }
   return solve_local(method_, problem, lambda, options_, hooks_, *workspace_,
                      "ContactSolver::solve");
 }

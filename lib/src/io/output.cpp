@@ -120,6 +120,68 @@ void check_bodies(hid_t root, const std::string& file, std::uint64_t rows,
   }
 }
 
+// Rows of the n × 3 dataset `name` (IoError naming it when it has another shape).
+std::uint64_t rows_of_three(hid_t location, const char* name, const std::string& file) {
+  Handle dataset = open_dataset(location, name, file);
+  Handle space = check(H5Dget_space(dataset.get()), H5Sclose, file,
+                       std::string("cannot read the shape of ") + name);
+  hsize_t dims[2] = {0, 0};
+  if (H5Sget_simple_extent_ndims(space.get()) != 2 ||
+      H5Sget_simple_extent_dims(space.get(), dims, nullptr) != 2 || dims[1] != 3) {
+    h5::fail(file, std::string("dataset ") + name + ": expected n × 3 values");
+  }
+  return dims[0];
+}
+
+// Writes the group /static: the static objects and the surface of triangles that draws them.
+StaticSurface write_static(hid_t root, const scene::Scene& scene, const std::string& file) {
+  const StaticSurface surface = static_surface(scene);
+  Handle group = check(H5Gcreate2(root, "static", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT),
+                       H5Gclose, file, "cannot create group static");
+  const hid_t g = group.get();
+  std::vector<double> points;
+  points.reserve(3 * surface.points.size());
+  for (const Vector3& p : surface.points) points.insert(points.end(), {p.x(), p.y(), p.z()});
+  h5::write_array(g, "points", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, surface.points.size(), 3,
+                  points.data(), file);
+  h5::write_array(g, "triangles", H5T_STD_U64LE, H5T_NATIVE_UINT64, surface.triangles.size(), 3,
+                  surface.triangles.data(), file);
+  h5::write_array(g, "object", H5T_STD_U32LE, H5T_NATIVE_UINT32, surface.object.size(), 0,
+                  surface.object.data(), file);
+  std::vector<const char*> names;
+  std::vector<std::uint8_t> shape;
+  std::vector<std::uint32_t> material;
+  for (const scene::StaticSpec& s : scene.statics) {
+    names.push_back(s.name.c_str());
+    shape.push_back(static_cast<std::uint8_t>(s.shape.index()));
+    const auto m = std::find(scene.materials.begin(), scene.materials.end(), s.material);
+    material.push_back(static_cast<std::uint32_t>(m - scene.materials.begin()));
+  }
+  Handle type = h5::string_type(file);
+  h5::write_array(g, "names", type.get(), type.get(), names.size(), 0, names.data(), file);
+  h5::write_array(g, "shape", H5T_STD_U8LE, H5T_NATIVE_UINT8, shape.size(), 0, shape.data(), file);
+  h5::write_array(g, "material", H5T_STD_U32LE, H5T_NATIVE_UINT32, material.size(), 0,
+                  material.data(), file);
+  h5::describe(g, "points", "m", "I", file);
+  h5::describe(g, "triangles", "1", nullptr, file);
+  h5::describe(g, "object", "1", nullptr, file);
+  h5::describe(g, "shape", "1", nullptr, file);
+  h5::describe(g, "material", "1", nullptr, file);
+  h5::write_attribute(g, "units",
+                      std::string("points: m (frame I); triangles: rows of points, outward "
+                                  "(counter-clockwise); object: row of names; shape: 0 sphere, "
+                                  "1 box, 2 capsule, 3 half-space, 4 mesh; material: row of "
+                                  "/materials; bounds: the box (rows min, max) that cuts a half-space's plane into a "
+                                  "polygon"),
+                      file);
+  // Where the half-spaces were cut: rows min and max.
+  const double bounds[6] = {surface.bounds.min.x(), surface.bounds.min.y(), surface.bounds.min.z(),
+                            surface.bounds.max.x(), surface.bounds.max.y(), surface.bounds.max.z()};
+  h5::write_array(g, "bounds", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, 2, 3, bounds, file);
+  h5::describe(g, "bounds", "m", "I", file);
+  return surface;
+}
+
 }  // namespace
 
 std::size_t first_different_line(std::string_view a, std::string_view b) {
@@ -147,6 +209,9 @@ struct OutputFile::Impl {
   // What the XDMF lists: time and body count of each complete record.
   std::vector<double> times;
   std::vector<std::uint64_t> counts;
+  // The static geometry's surface (/static): vertices and triangles, 0 when there is none.
+  std::uint64_t static_points = 0;
+  std::uint64_t static_triangles = 0;
   // The XDMF file, open to append records over its footer, which starts at xdmf_footer.
   std::fstream xdmf;
   std::streamoff xdmf_footer = 0;
@@ -217,6 +282,9 @@ OutputFile::OutputFile(const std::filesystem::path& path, const scene::Scene& sc
                                   "kinetic_energy, potential_energy: J; max_penetration: m; "
                                   "seconds_*: s of wall time"),
                       o.file);
+  const StaticSurface surface = write_static(root, scene, o.file);
+  o.static_points = surface.points.size();
+  o.static_triangles = surface.triangles.size();
   check(H5Fflush(root, H5F_SCOPE_LOCAL), o.file, "cannot flush");
   write_xdmf();
 }
@@ -246,6 +314,11 @@ OutputFile::OutputFile(const std::filesystem::path& path, const scene::Scene& sc
   }
   o.bodies = open_dataset(root, "bodies", o.file);
   o.steps = open_dataset(root, "steps", o.file);
+  if (H5Lexists(root, "static", H5P_DEFAULT) > 0) {  // outputs of earlier versions have none
+    Handle group = open_group(root, "static", o.file);
+    o.static_points = rows_of_three(group.get(), "points", o.file);
+    o.static_triangles = rows_of_three(group.get(), "triangles", o.file);
+  }
   o.records = open_group(root, "records", o.file);
   o.record_time = open_dataset(o.records.get(), "time", o.file);
   o.record_step = open_dataset(o.records.get(), "step", o.file);
@@ -491,7 +564,29 @@ void OutputFile::write_xdmf() {
   x << "<?xml version=\"1.0\" ?>\n"
     << "<!DOCTYPE Xdmf SYSTEM \"Xdmf.dtd\" []>\n"
     << "<Xdmf Version=\"2.0\">\n"
-    << " <Domain>\n"
+    << " <Domain>\n";
+  if (o.static_triangles > 0) {  // the static geometry: one grid of triangles, for every time
+    const std::string base = h5_name + ":/static/";
+    x << "  <Grid Name=\"static\" GridType=\"Uniform\">\n"
+      << "   <Topology TopologyType=\"Triangle\" NumberOfElements=\"" << o.static_triangles
+      << "\">\n"
+      << "    <DataItem Dimensions=\"" << o.static_triangles
+      << " 3\" NumberType=\"UInt\" Precision=\"8\" Format=\"HDF\">" << base
+      << "triangles</DataItem>\n"
+      << "   </Topology>\n"
+      << "   <Geometry GeometryType=\"XYZ\">\n"
+      << "    <DataItem Dimensions=\"" << o.static_points
+      << " 3\" NumberType=\"Float\" Precision=\"8\" Format=\"HDF\">" << base
+      << "points</DataItem>\n"
+      << "   </Geometry>\n"
+      << "   <Attribute Name=\"object\" AttributeType=\"Scalar\" Center=\"Cell\">\n"
+      << "    <DataItem Dimensions=\"" << o.static_triangles
+      << "\" NumberType=\"UInt\" Precision=\"4\" Format=\"HDF\">" << base
+      << "object</DataItem>\n"
+      << "   </Attribute>\n"
+      << "  </Grid>\n";
+  }
+  x
     << "  <Grid Name=\"bodies\" GridType=\"Collection\" CollectionType=\"Temporal\">\n";
   for (std::size_t k = 0; k < o.times.size(); ++k) {
     if (o.counts[k] == 0) continue;  // ParaView cannot show an empty grid

@@ -861,6 +861,15 @@ Scene parse_scene(std::string_view text, const std::filesystem::path& file) {
       }
     }
   }
+  // The length the active-set tolerance scales, once for the whole run and the same on every
+  // process: the smallest bounding radius any group can produce (not the smallest present, which
+  // an inflow or an outlet would change).
+  for (const BodyGroup& g : scene.groups) {
+    const double r = smallest_bounding_radius(g);
+    if (scene.settings.tolerance_radius == 0.0 || r < scene.settings.tolerance_radius) {
+      scene.settings.tolerance_radius = r;
+    }
+  }
   if (scene.output.file.empty()) scene.output.file = scene.name + ".h5";
   if (scene.checkpoint.file.empty()) scene.checkpoint.file = scene.name + ".ckpt.h5";
   return scene;

@@ -234,6 +234,15 @@ double largest_bounding_radius(const BodyGroup& group) {
   return bounding_radius(largest);
 }
 
+double smallest_bounding_radius(const BodyGroup& group) {
+  BodyConstants smallest;
+  smallest.shape = group.shape;
+  smallest.radius = group.radius.min();
+  smallest.half_extents = group.half_extents;
+  smallest.half_length = group.half_length;
+  return bounding_radius(smallest);
+}
+
 // Buffers of the generators, kept between steps so that an inflow allocates nothing once warm.
 struct Simulation::Scratch {
   OverlapGrid grid;
@@ -693,6 +702,7 @@ void Simulation::outlet() {
 
 timestep::StepReport Simulation::step() {
   inflow();
+  stepper_->reorder_if_due();  // between steps, where a parallel run migrates bodies
   timestep::StepReport report = stepper_->step();
   outlet();
   return report;

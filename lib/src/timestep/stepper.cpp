@@ -35,6 +35,11 @@ void require_settings(const StepSettings& s) {
     throw InvalidArgument(where + "expected reorder_interval >= 0 (0: never), found " +
                           std::to_string(s.reorder_interval));
   }
+  if (!(s.tolerance_radius >= 0.0) || !std::isfinite(s.tolerance_radius)) {
+    throw InvalidArgument(where + "expected a finite tolerance_radius >= 0 (0: the smallest "
+                          "bounding radius of the first bodies), found " +
+                          format_number(s.tolerance_radius));
+  }
   if (!(s.contact_tolerance >= 0.0) || !std::isfinite(s.contact_tolerance)) {
     throw InvalidArgument(where + "expected a finite contact_tolerance >= 0, found " +
                           format_number(s.contact_tolerance));
@@ -69,12 +74,14 @@ std::string id_name(std::uint64_t id) {
 }  // namespace
 
 MoreauStepper::MoreauStepper(BodySystem& system, const StaticGeometry& statics,
-                             const MaterialTable& materials, StepSettings settings)
+                             const MaterialTable& materials, StepSettings settings,
+                             StepHooks hooks)
     : system_(system),
       statics_(statics),
       materials_(materials),
       settings_((require_settings(settings), settings)),
-      solver_(settings.method, settings.solver) {
+      hooks_(std::move(hooks)),
+      solver_(settings.method, settings.solver, hooks_.solver) {
   check_layout();
 }
 
@@ -133,7 +140,12 @@ void MoreauStepper::check_layout() {
   }
   materials_.require_pairs(body_materials, body_materials);
   materials_.require_pairs(body_materials, static_materials);
-  tolerance_ = n > 0 ? settings_.contact_tolerance * smallest : 0.0;
+  // The length the tolerance scales is the settings', or fixed by the first bodies seen.
+  if (settings_.tolerance_radius > 0.0) {
+    tolerance_ = settings_.contact_tolerance * settings_.tolerance_radius;
+  } else if (tolerance_ == 0.0 && n > 0) {
+    tolerance_ = settings_.contact_tolerance * smallest;
+  }
   const auto body_name = [&](std::int64_t i) {
     return id_name(system_.ids()[static_cast<std::size_t>(i)]);
   };
@@ -166,25 +178,50 @@ void MoreauStepper::check_layout() {
 StepReport MoreauStepper::step() {
   const auto t0 = Clock::now();
   check_layout();
-  if (settings_.reorder_interval > 0 && steps_ > 0 &&
-      steps_ % static_cast<std::uint64_t>(settings_.reorder_interval) == 0 && system_.size() > 0) {
-    const auto radii = system_.bounding_radii();
-    system_.reorder_morton(2.0 * *std::max_element(radii.begin(), radii.end()));
-    checked_layout_ = system_.layout_version();  // the same bodies, reordered
-  }
+  StepReport report;
+  report.step = steps_ + 1;
+  report.t = t_ + settings_.dt;
+  midpoint(report);  // q_M, the loads there, u_free
+  const auto t1 = Clock::now();
+  detect(report);  // the active set at q_M; hook after_detection
+  const auto t2 = Clock::now();
+  assemble(report);  // the contact problem, warm-started; hook after_assembly
+  const auto t3 = Clock::now();
+  solve(report);  // Λ and u_E; the solver's hooks
+  const auto t4 = Clock::now();
+  finish(report);  // q_E, warm starts kept, energies, blow-up checks; the clock advances
+  const auto t5 = Clock::now();
+  report.seconds = {seconds(t0, t1), seconds(t1, t2), seconds(t2, t3),
+                    seconds(t3, t4), seconds(t4, t5), seconds(t0, t5)};
+  if (hooks_.reduce_report) hooks_.reduce_report(report);
+  return report;
+}
+// [step]
+
+Vector7 MoreauStepper::half(const Vector7& q, const Vector6& u) const {
+  return settings_.orientation_update == OrientationUpdate::exponential_map
+             ? half_step(q, u, settings_.dt)
+             : half_step_add_normalize(q, u, settings_.dt);
+}
+
+bool MoreauStepper::reorder_if_due() {
+  check_layout();
+  const auto interval = static_cast<std::uint64_t>(settings_.reorder_interval);
+  if (interval == 0 || steps_ == 0 || steps_ % interval != 0 || system_.size() == 0) return false;
+  const auto radii = system_.bounding_radii();
+  system_.reorder_morton(2.0 * *std::max_element(radii.begin(), radii.end()));
+  checked_layout_ = system_.layout_version();  // the same bodies, reordered
+  return true;
+}
+
+// [stage midpoint]
+// 1. The midpoint q_M = q_S + Δt/2 F(q_S) u_S, the loads there, and the problem's world-frame
+// inverse masses, u_free = u_S + Δt M⁻¹ h and u_S (in solution_.u until the solver overwrites it).
+void MoreauStepper::midpoint(const StepReport& report) {
   const double dt = settings_.dt;
   const std::size_t n = system_.size();
   const auto states = system_.states();
   const auto inertia = system_.inertia();
-  const bool exp_map = settings_.orientation_update == OrientationUpdate::exponential_map;
-  const auto half = [&](const Vector7& q, const Vector6& u) {
-    return exp_map ? half_step(q, u, dt) : half_step_add_normalize(q, u, dt);
-  };
-  StepReport report;
-  report.step = steps_ + 1;
-  report.t = t_ + dt;
-
-  // 1. The midpoint q_M = q_S + Δt/2 F(q_S) u_S, the loads there, u_free = u_S + Δt M⁻¹ h.
   bool finite = true;
   for (std::size_t i = 0; i < n; ++i) {
     if (!system_.dynamic(i)) continue;
@@ -200,9 +237,6 @@ StepReport MoreauStepper::step() {
                                           id_name(system_.ids()[i]));
     }
   }
-  // The contact problem is written in the world frame (contact::CompactProblem): at q_M each
-  // body's inverse inertia A K_Θ⁻¹ Aᵀ, and u_free and u_S with ω in frame I. solution_.u holds
-  // u_S until the solver overwrites it with u_E.
   problem_.M_inv.resize(n);
   problem_.u_free.resize(n);
   solution_.u.resize(n);
@@ -224,9 +258,12 @@ StepReport MoreauStepper::step() {
     problem_.u_free[i] << u_free.head<3>(), A_IK * u_free.tail<3>();
     solution_.u[i] << states[i].u.head<3>(), A_IK * states[i].u.tail<3>();
   }
-  const auto t1 = Clock::now();
+}
+// [stage midpoint]
 
-  // 2. Contacts at the midpoint; Moreau's active set g_N(q_M) ≤ 0 (to the tolerance).
+// [stage detect]
+// 2. Contacts at the midpoint; Moreau's active set g_N(q_M) ≤ 0 (to the tolerance).
+void MoreauStepper::detect(const StepReport& report) {
   try {
     detector_.detect(system_, statics_, tolerance_, contacts_, keys_);
   } catch (const InvalidArgument& e) {  // a state set from outside that is not finite
@@ -244,10 +281,22 @@ StepReport MoreauStepper::step() {
   }
   contacts_.resize(active);
   keys_.resize(active);
-  const auto t2 = Clock::now();
+  if (hooks_.after_detection) {
+    hooks_.after_detection(system_, contacts_, keys_);
+    if (keys_.size() != contacts_.size()) {
+      throw InvalidArgument("StepHooks::after_detection left " + std::to_string(contacts_.size()) +
+                            " contacts and " + std::to_string(keys_.size()) +
+                            " keys: expected one key per contact");
+    }
+  }
+}
+// [stage detect]
 
-  // 3. The contact problem at q_M: the frame and the lever arms of each contact, γ_S from the
-  // velocities at the start, the materials of the pair.
+// [stage assemble]
+// 3. The contact problem at q_M: the frame and the lever arms of each contact, γ_S from the
+// velocities at the start, the materials of the pair; the warm start.
+void MoreauStepper::assemble(StepReport& report) {
+  const auto states = system_.states();
   const std::size_t m = contacts_.size();
   problem_.contacts.resize(m);
   for (std::size_t k = 0; k < m; ++k) {
@@ -286,38 +335,59 @@ StepReport MoreauStepper::step() {
   } else {
     std::fill(solution_.lambda.begin(), solution_.lambda.end(), Vector3::Zero());
   }
-  const auto t3 = Clock::now();
-
-  // 4. The contact problem.
-  report.contacts = m;
-  if (m > 0) {
-    const contact::SolverResult result = solver_.solve_prepared(problem_, solution_);
-    report.iterations = result.iterations;
-    report.residual = result.residual;
-    report.converged = result.converged;
-    if (result.diverged) {
-      throw Error("MoreauStepper: step " + std::to_string(report.step) + " (t = " +
-                  format_number(report.t) + " s): the contact solver diverged: " +
-                  contact::describe(result));
+  if (hooks_.after_assembly) {
+    const std::size_t bodies = problem_.M_inv.size();
+    hooks_.after_assembly(problem_, solution_);
+    if (problem_.contacts.size() != m || problem_.M_inv.size() != bodies ||
+        problem_.u_free.size() != bodies || solution_.lambda.size() != m ||
+        solution_.u.size() != bodies) {
+      throw InvalidArgument("StepHooks::after_assembly changed the number of bodies or contacts "
+                            "of the problem; it may change their values only");
     }
-    if (!result.converged) {
-      ++non_converged_;
-      if (settings_.on_non_convergence == NonConvergence::stop) {
-        throw Error("MoreauStepper: step " + std::to_string(report.step) + " (t = " +
-                    format_number(report.t) + " s): " + contact::describe(result));
-      }
-      if (settings_.on_non_convergence == NonConvergence::warn) {
-        std::fprintf(stderr, "grbd: step %llu (t = %s s): %s\n",
-                     static_cast<unsigned long long>(report.step), format_number(report.t).c_str(),
-                     contact::describe(result).c_str());
-      }
-    }
-  } else {
-    solution_.u.assign(problem_.u_free.begin(), problem_.u_free.end());
   }
-  const auto t4 = Clock::now();
+}
+// [stage assemble]
 
-  // 5. u_E, q_E = q_M + Δt/2 F(q_M) u_E.
+// [stage solve]
+// 4. The contact problem: Λ and u_E (world frame).
+void MoreauStepper::solve(StepReport& report) {
+  const std::size_t m = contacts_.size();
+  report.contacts = m;
+  if (m == 0) {
+    solution_.u.assign(problem_.u_free.begin(), problem_.u_free.end());
+    return;
+  }
+  const contact::SolverResult result = solver_.solve_prepared(problem_, solution_);
+  report.iterations = result.iterations;
+  report.residual = result.residual;
+  report.converged = result.converged;
+  if (result.diverged) {
+    throw Error("MoreauStepper: step " + std::to_string(report.step) + " (t = " +
+                format_number(report.t) + " s): the contact solver diverged: " +
+                contact::describe(result));
+  }
+  if (!result.converged) {
+    ++non_converged_;
+    if (settings_.on_non_convergence == NonConvergence::stop) {
+      throw Error("MoreauStepper: step " + std::to_string(report.step) + " (t = " +
+                  format_number(report.t) + " s): " + contact::describe(result));
+    }
+    if (settings_.on_non_convergence == NonConvergence::warn) {
+      std::fprintf(stderr, "grbd: step %llu (t = %s s): %s\n",
+                   static_cast<unsigned long long>(report.step), format_number(report.t).c_str(),
+                   contact::describe(result).c_str());
+    }
+  }
+}
+// [stage solve]
+
+// [stage finish]
+// 5. u_E back in the body frames, q_E = q_M + Δt/2 F(q_M) u_E, the warm starts kept, the
+// energies and the checks for a blow-up; the clock advances.
+void MoreauStepper::finish(StepReport& report) {
+  const std::size_t n = system_.size();
+  const auto states = system_.states();
+  const auto inertia = system_.inertia();
   for (std::size_t i = 0; i < n; ++i) {
     if (!system_.dynamic(i)) continue;
     // Only the change of ω goes back to frame K: ω_K,E = ω_K,S + A_IKᵀ(ω_I,E − A_IK ω_K,S),
@@ -335,6 +405,7 @@ StepReport MoreauStepper::step() {
   if (settings_.drift_correction > 0.0) correct_drift();
   if (settings_.warm_start) warm_.store(keys_, solution_.lambda);
   const auto radii = system_.bounding_radii();
+  bool finite = true;
   for (std::size_t i = 0; i < n; ++i) {
     if (!system_.dynamic(i)) continue;
     report.kinetic_energy += body::kinetic_energy(inertia[i], states[i].u);
@@ -351,14 +422,10 @@ StepReport MoreauStepper::step() {
   for (const DetectedContact& c : contacts_) {
     report.max_penetration = std::max(report.max_penetration, -c.geometry.g_N);
   }
-  t_ += dt;
+  t_ += settings_.dt;
   ++steps_;
-  const auto t5 = Clock::now();
-  report.seconds = {seconds(t0, t1), seconds(t1, t2), seconds(t2, t3),
-                    seconds(t3, t4), seconds(t4, t5), seconds(t0, t5)};
-  return report;
 }
-// [step]
+// [stage finish]
 
 // Names the first body whose state or energy is not finite in the step of `report` (`where`: ""
 // after the step, " at the midpoint" after its first half).

@@ -209,6 +209,15 @@ struct SolverHooks {
   /// test; JOR and APGD recompute u from Λ (and do so once more at the end), so for them only
   /// changes to Λ count, and APGD's own buffers (momentum, ξ) do not follow such a change.
   std::function<void(int k, std::span<Vector3> lambda, std::span<Vector6> u)> after_iteration;
+  /// Called after every iteration k (1-based), after after_iteration and before the stopping
+  /// test, with the body velocities u only: for a hook that changes u and nothing else, such as
+  /// the mass splitting of chapter 8, which replaces the velocities of a split body's copies by
+  /// their mass-weighted mean. Λ is not shown, so it cannot change, and SOR stays on its fast
+  /// path: its sweep keeps testing its own change of Λ and its finiteness, and no copy of Λ is
+  /// made per iteration (an after_iteration hook costs both). The next sweep starts from the
+  /// changed u. SOR only, in the body and compact forms: ContactSolver refuses it for JOR and
+  /// APGD, which recompute u from Λ and would drop the change, and the local form has no u.
+  std::function<void(int k, std::span<Vector6> u)> velocities_between_sweeps;
   /// Turns this process's status after an iteration into the global one: with MPI the maximum
   /// over the ranks (MPI_Allreduce with MPI_MAX on the integer values of IterationStatus), so
   /// that every process stops as diverged when one of them diverged, and as converged only when

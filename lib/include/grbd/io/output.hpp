@@ -13,11 +13,14 @@
 ///   largest penetration, bodies, stage timings);
 /// - `/records/time`, `/records/step`, `/records/bodies`, and one group `/records/NNNNNN` per
 ///   record with `id`, `I_r_S`, `p`, `I_v_S`, `K_omega` and `radius`, rows in ascending global id;
-///   the attribute `/records@count` is the number of complete records.
+///   the attribute `/records@count` is the number of complete records;
+/// - `/static`: the static geometry as triangles (`points`, `triangles`, `object`) and the
+///   static objects' `names`, `shape` and `material` (see StaticSurface).
 ///
 /// After every record the file is flushed and `count` is written last, so that a run killed at
 /// any moment leaves a file that opens and holds every record counted.
 
+#include <array>
 #include <cstdint>
 #include <filesystem>
 #include <memory>
@@ -55,6 +58,25 @@ struct RunIdentity {
   std::string scene_text;                        ///< the scene the run was started from
   std::span<const scene::BodyConstants> bodies;  ///< the bodies at the checkpoint
 };
+
+/// The static geometry of a scene as one surface of triangles in frame I, which the output keeps
+/// (group `/static`) so that ParaView shows the walls, floors and meshes among the bodies.
+/// Spheres, boxes and capsules are tessellated (an icosphere of 320 faces, 12 faces, 24
+/// segments around with 6 rings per hemisphere), meshes are taken as they are, and a half-space,
+/// being infinite, is drawn as the polygon in which its plane cuts `bounds`: the outlet's box
+/// when the scene has one, else the box of every body group's region or positions and of the
+/// finite static objects, enlarged by 5 % of its largest side (at least two body sizes); each
+/// plane is cut further by the other half-spaces, so that the planes draw the boundary of the
+/// free space (a silo's floor between its walls).
+struct StaticSurface {
+  std::vector<Vector3> points;                          ///< vertices [m], frame I
+  std::vector<std::array<std::uint64_t, 3>> triangles;  ///< rows of points, outward faces
+  std::vector<std::uint32_t> object;                    ///< per triangle: index in scene.statics
+  scene::Region bounds;                                 ///< where half-spaces were cut [m]
+};
+
+/// The surface of `scene.statics` (see StaticSurface).
+StaticSurface static_surface(const scene::Scene& scene);
 
 /// The line (1, 2, …) on which two texts first differ.
 std::size_t first_different_line(std::string_view a, std::string_view b);

@@ -118,6 +118,11 @@ struct DomainSpec {
   Region box;            ///< the domain [m]
 };
 
+/// The radius of the sphere about S that holds a body of a group, at its smallest [m]: the
+/// smallest radius its distribution can give (sphere, capsule), or the box's. The scene's active-set
+/// tolerance scales the smallest over its groups (StepSettings::tolerance_radius).
+double smallest_bounding_radius(const BodyGroup& group);
+
 /// Everything a scene file says, checked: every value in range, every material named exists,
 /// every pair of materials that can meet has a law.
 struct Scene {

@@ -49,14 +49,21 @@ struct StepSettings {
   contact::Method method = contact::Method::sor;  ///< the contact solver
   contact::SolverOptions solver;             ///< its options
   bool warm_start = true;                    ///< start each solve from the last step's percussions
-  /// Reorder the bodies along the Morton curve every this many steps (0: never).
+  /// Reorder the bodies along the Morton curve every this many steps (0: never): the driver
+  /// does it between steps with MoreauStepper::reorder_if_due().
   int reorder_interval = 0;
   NonConvergence on_non_convergence = NonConvergence::count;  ///< see NonConvergence
   OrientationUpdate orientation_update = OrientationUpdate::exponential_map;  ///< half steps
-  /// A contact is active when g_N(q_M) ≤ contact_tolerance × the smallest body radius: Moreau's
+  /// A contact is active when g_N(q_M) ≤ contact_tolerance × tolerance_radius: Moreau's
   /// g_N ≤ 0 made robust against round-off, which otherwise opens the corners of a box resting
   /// on a face by 10⁻¹⁷ m and lets it rock. ≥ 0 and finite.
   double contact_tolerance = 1e-9;
+  /// The length that contact_tolerance scales [m], ≥ 0 and finite. A scene sets the smallest
+  /// bounding radius that any of its body groups can produce, so that the active set does not
+  /// depend on which bodies are present (an inflow, an outlet) or on which of them a process
+  /// holds. 0: the smallest bounding radius among the bodies when the stepper first sees any,
+  /// kept from then on.
+  double tolerance_radius = 0.0;
   /// Penetration drift correction β ∈ [0, 1] (0: off, the default): after the step, each active
   /// contact with g_N(q_M) < 0 pushes its bodies apart by β|g_N| along the normal (positions
   /// only, velocities untouched), shared by inverse mass and divided among the contacts of a body.
@@ -93,7 +100,38 @@ struct StepReport {
 using ExternalLoads =
     std::function<void(double t_M, const BodySystem& system, std::span<body::Loads> loads)>;
 
+/// Where a driver takes part in a step (chapter 8's parallel engine: the contacts a process
+/// solves, split bodies, reductions over processes), in the idiom of contact::SolverHooks and
+/// ExternalLoads: plain functions, an empty one is not called. What each may change is part of
+/// its contract; with no hook set, a step is exactly the serial step.
+struct StepHooks {
+  /// After detection and the active set, before assembly: the active contacts at q_M and their
+  /// keys, one per contact, in canonical order. May remove contacts (keeping the two vectors
+  /// aligned and in order), e.g. keep only those this process solves; must not add contacts or
+  /// change their geometry.
+  std::function<void(const BodySystem& system, std::vector<DetectedContact>& contacts,
+                     std::vector<ContactKey>& keys)>
+      after_detection;
+  /// After assembly, before the solve: the contact problem in the compact form (world-frame M⁻¹
+  /// at q_M, u_free, the contacts with their frames, lever arms, μ and ξ_A) and the initial guess
+  /// (solution.lambda, warm-started; solution.u holds u_S in frame I). May change the inverse
+  /// masses and free velocities of bodies (a split body's copy carries M⁻¹ scaled by its
+  /// multiplicity) and the guess; must not change the number or the order of bodies or contacts.
+  std::function<void(contact::CompactProblem& problem, contact::ContactSolution& solution)>
+      after_assembly;
+  /// The contact solver's own hooks, given to its ContactSolver: between iterations
+  /// (velocities_between_sweeps keeps SOR on its fast path) and the global stopping decision.
+  contact::SolverHooks solver;
+  /// Last thing in a step: turns this process's report into the global one (contacts and
+  /// energies summed, residual, iterations and penetration maximised, converged only if
+  /// everywhere). Called after the step has succeeded.
+  std::function<void(StepReport& report)> reduce_report;
+};
+
 /// Moreau's midpoint scheme for a BodySystem among a StaticGeometry, with per-pair materials.
+///
+/// A step runs five named stages — midpoint(), detect(), assemble(), solve(), finish() — with the
+/// hooks of StepHooks between them (see step()).
 ///
 /// The stepper keeps references to the three (they must outlive it) and owns every buffer of a
 /// step; after the first steps, a step of a settled system allocates nothing. Bodies may be
@@ -104,7 +142,7 @@ class MoreauStepper {
   /// Checks the settings, that every pair of materials in use has a law (naming both
   /// materials), and that every pair of shapes that can meet is supported.
   MoreauStepper(BodySystem& system, const StaticGeometry& statics, const MaterialTable& materials,
-                StepSettings settings = {});
+                StepSettings settings = {}, StepHooks hooks = {});
 
   /// One step of length Δt; returns its report. Throws grbd::Error when the solver diverges or
   /// (NonConvergence::stop) does not converge, the system then left at the midpoint state; and
@@ -113,6 +151,13 @@ class MoreauStepper {
   /// step, the time and the body's id: the system then holds that state, which must not be
   /// continued.
   StepReport step();
+
+  /// Between steps, the driver's call: reorders the bodies along the Morton curve
+  /// (BodySystem::reorder_morton, cells of twice the largest bounding radius) when
+  /// settings().reorder_interval asks for it before the next step — steps() > 0 and a multiple of
+  /// the interval — and returns whether it did. The stepper keeps what it checked of the layout
+  /// (the same bodies, reordered). A parallel driver migrates bodies at the same point.
+  bool reorder_if_due();
 
   /// Time [s] at the end of the last step.
   double time() const { return t_; }
@@ -127,6 +172,10 @@ class MoreauStepper {
   ExternalLoads external_loads;
   /// The settings.
   const StepSettings& settings() const { return settings_; }
+  /// The hooks.
+  const StepHooks& hooks() const { return hooks_; }
+  /// The active-set tolerance contact_tolerance × tolerance_radius [m] (0 before any body).
+  double active_set_tolerance() const { return tolerance_; }
 
   /// \name The last step
   /// Contacts (at the midpoint, canonical order), their keys and percussions, and the contact
@@ -143,6 +192,15 @@ class MoreauStepper {
   const WarmStartTable& warm_starts() const { return warm_; }
 
  private:
+  // The stages of step(), in order.
+  void midpoint(const StepReport& report);
+  void detect(const StepReport& report);
+  void assemble(StepReport& report);
+  void solve(StepReport& report);
+  void finish(StepReport& report);
+
+  // Half a step of the positions with the settings' orientation update.
+  Vector7 half(const Vector7& q, const Vector6& u) const;
   void check_layout();
   void correct_drift();
   [[noreturn]] void require_finite(const StepReport& report, const char* where) const;
@@ -151,6 +209,7 @@ class MoreauStepper {
   const StaticGeometry& statics_;
   const MaterialTable& materials_;
   StepSettings settings_;
+  StepHooks hooks_;
   contact::ContactSolver solver_;
   ContactDetector detector_;
   WarmStartTable warm_;
@@ -158,7 +217,7 @@ class MoreauStepper {
   std::uint64_t steps_ = 0;
   std::uint64_t non_converged_ = 0;
   std::uint64_t checked_layout_ = ~std::uint64_t{0};
-  double tolerance_ = 0.0;  // contact_tolerance × the smallest bounding radius [m]
+  double tolerance_ = 0.0;  // contact_tolerance × tolerance_radius [m]
 
   std::vector<body::Loads> loads_;
   std::vector<DetectedContact> contacts_;
