@@ -104,6 +104,7 @@ using ExternalLoads =
 /// solves, split bodies, reductions over processes), in the idiom of contact::SolverHooks and
 /// ExternalLoads: plain functions, an empty one is not called. What each may change is part of
 /// its contract; with no hook set, a step is exactly the serial step.
+// [step hooks]
 struct StepHooks {
   /// After detection and the active set, before assembly: the active contacts at q_M and their
   /// keys, one per contact, in canonical order. May remove contacts (keeping the two vectors
@@ -127,6 +128,7 @@ struct StepHooks {
   /// everywhere). Called after the step has succeeded.
   std::function<void(StepReport& report)> reduce_report;
 };
+// [step hooks]
 
 /// Moreau's midpoint scheme for a BodySystem among a StaticGeometry, with per-pair materials.
 ///
