@@ -109,6 +109,15 @@ TEST(SceneFile, TheActiveSetToleranceScalesTheSmallestRadiusAnyGroupCanProduce) 
   EXPECT_EQ(simulation.stepper().active_set_tolerance(), tolerance);
 }
 
+TEST(SceneFile, ASimulationKeepsItsOwnCopyOfTheScene) {
+  // Built from a temporary scene, it runs on: it does not refer to the scene it was given.
+  const auto path = std::filesystem::path(GRBD_CH07_DATA_DIR) / "chute.toml";
+  grbd::scene::Simulation simulation(grbd::scene::load_scene(path));
+  for (int step = 0; step < 20; ++step) simulation.step();
+  EXPECT_EQ(simulation.scene().text, read(path));
+  EXPECT_EQ(simulation.stepper().steps(), 20U);
+}
+
 TEST(SceneFile, UnknownKeysAreErrorsWithTheClosestKnownKey) {
   EXPECT_EQ(error_of(replace(kMinimal, "end_time", "end_tme")),
             "scene.toml:3:1: simulation.end_tme: unknown key (did you mean \"end_time\"?)");
@@ -122,6 +131,27 @@ TEST(SceneFile, UnknownKeysAreErrorsWithTheClosestKnownKey) {
       << far;
   EXPECT_EQ(error_of(replace(kMinimal, "[simulation]", "[simulaton]\ndt=1\n[simulation]")),
             "scene.toml:1:2: simulaton: unknown key (did you mean \"simulation\"?)");
+}
+
+TEST(SceneFile, AMisspeltKeyOfAnEitherOrPairIsNamedAtItsLine) {
+  // Exactly one of density and mass, of positions and [bodies.generator]: when neither is found
+  // because one is misspelt, the message is the misspelling's, at its line, not "found neither".
+  EXPECT_EQ(error_of(replace(kMinimal, "density = 2500", "densty = 2500")),
+            "scene.toml:13:1: bodies[0].densty: unknown key (did you mean \"density\"?)");
+  EXPECT_EQ(error_of(replace(kMinimal, "density = 2500", "mas = 0.01")),
+            "scene.toml:13:1: bodies[0].mas: unknown key (did you mean \"mass\"?)");
+  EXPECT_EQ(error_of(replace(kMinimal, "positions = ", "positons = ")),
+            "scene.toml:15:1: bodies[0].positons: unknown key (did you mean \"positions\"?)");
+  EXPECT_EQ(error_of(replace(kMinimal, "positions = [[0.0, 0.0, 0.1], [0.0, 0.0, 0.2]]",
+                             "[bodies.generatr]\nkind = \"lattice\"")),
+            "scene.toml:15:9: bodies[0].generatr: unknown key (did you mean \"generator\"?)");
+  // Truly neither, or both: said as such.
+  EXPECT_NE(error_of(replace(kMinimal, "density = 2500\n", "")).find(
+                "expected exactly one of density [kg/m³] and mass [kg], found neither"),
+            std::string::npos);
+  EXPECT_NE(error_of(replace(kMinimal, "density = 2500", "density = 2500\nmass = 1.0")).find(
+                "found both"),
+            std::string::npos);
 }
 
 TEST(SceneFile, OutOfRangeValuesNameTheKeyTheRangeAndTheValue) {

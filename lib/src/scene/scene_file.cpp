@@ -213,6 +213,17 @@ class TableReader {
     }
     fail_at(table_.source(), key, expected, "nothing (the key is required)");
   }
+  // "Exactly one of `keys`" found neither of them: a key of the table that was not asked for and
+  // is close to one of them is a misspelling, which explains the absence better, at its line.
+  [[noreturn]] void neither(std::vector<std::string_view> keys, std::string_view key,
+                            std::string_view expected) const {
+    for (const auto& [name, node] : table_) {
+      if (std::find(known_.begin(), known_.end(), name.str()) != known_.end()) continue;
+      const std::string near = closest_key(name.str(), keys);
+      if (!near.empty()) unknown(name, near);
+    }
+    fail_at(table_.source(), key, expected, "neither");
+  }
   [[noreturn]] void unknown(const toml::key& key, std::string_view near) const {
     std::ostringstream out;
     out << position(file_, key.source()) << ": " << key_path(key.str()) << ": unknown key";
@@ -632,10 +643,10 @@ GeneratorSpec read_generator(TableReader& group, const Scene& scene, std::size_t
   g.seed = scene.seed + 0x9E3779B97F4A7C15ULL * (index + 1);
   const bool has_positions = group.get("positions") != nullptr;
   const toml::table* table = group.table_opt("generator");
-  if (has_positions == (table != nullptr)) {
-    group.fail_at(group.table().source(), "generator",
-                  "either positions = [[x, y, z], …] or a table [bodies.generator]",
-                  has_positions ? "both" : "neither");
+  const char* either = "either positions = [[x, y, z], …] or a table [bodies.generator]";
+  if (!has_positions && table == nullptr) group.neither({"positions", "generator"}, "generator", either);
+  if (has_positions && table != nullptr) {
+    group.fail_at(group.table().source(), "generator", either, "both");
   }
   if (has_positions) {
     const toml::node* node = group.table().get("positions");
@@ -701,10 +712,9 @@ void read_group(TableReader& t, Scene& scene, std::size_t index) {
   }
   g.density = t.real_opt("density", kPositive);
   g.mass = t.real_opt("mass", kPositive);
-  if (g.density.has_value() == g.mass.has_value()) {
-    t.fail_at(t.table().source(), "density", "exactly one of density [kg/m³] and mass [kg]",
-              g.density ? "both" : "neither");
-  }
+  const char* one_of = "exactly one of density [kg/m³] and mass [kg]";
+  if (!g.density && !g.mass) t.neither({"density", "mass"}, "density", one_of);
+  if (g.density && g.mass) t.fail_at(t.table().source(), "density", one_of, "both");
   g.material = t.string_required("material", "the name of a declared material");
   material_index(scene, t, "material", g.material);
   g.I_v_S = t.vector("velocity", Vector3::Zero());

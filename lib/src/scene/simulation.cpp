@@ -281,36 +281,36 @@ std::pair<double, std::size_t> Simulation::static_gap(const BodyConstants& c,
   return {gap, which};
 }
 
-Simulation::Simulation(const Scene& scene) : Simulation(scene, nullptr) {}
+Simulation::Simulation(Scene scene) : Simulation(std::move(scene), nullptr) {}
 
-Simulation::Simulation(const Scene& scene, const SimulationState& state)
-    : Simulation(scene, &state) {}
+Simulation::Simulation(Scene scene, const SimulationState& state)
+    : Simulation(std::move(scene), &state) {}
 
-Simulation::Simulation(const Scene& scene, const SimulationState* state)
-    : scene_(scene), scratch_(std::make_unique<Scratch>()) {
-  for (const std::string& name : scene.materials) materials_.add(name);
-  if (scene.default_contact) materials_.set_default(*scene.default_contact);
-  for (const ContactSpec& c : scene.contacts) {
+Simulation::Simulation(Scene scene, const SimulationState* state)
+    : scene_(std::move(scene)), scratch_(std::make_unique<Scratch>()) {
+  for (const std::string& name : scene_.materials) materials_.add(name);
+  if (scene_.default_contact) materials_.set_default(*scene_.default_contact);
+  for (const ContactSpec& c : scene_.contacts) {
     materials_.set_pair(*materials_.find(c.a), *materials_.find(c.b), c.law);
   }
   build_static();
   check_shapes();
   require_invertible_constants();
-  generators_.resize(scene.groups.size());
+  generators_.resize(scene_.groups.size());
   if (state == nullptr) {
-    for (std::size_t g = 0; g < scene.groups.size(); ++g) {
-      generators_[g].random = scene.groups[g].generator.seed;
+    for (std::size_t g = 0; g < scene_.groups.size(); ++g) {
+      generators_[g].random = scene_.groups[g].generator.seed;
     }
     generate_initial();
   } else {
     restore(*state);
   }
   try {
-    stepper_.emplace(system_, statics_, materials_, scene.settings);
+    stepper_.emplace(system_, statics_, materials_, scene_.settings);
   } catch (const SceneError&) {
     throw;
   } catch (const InvalidArgument& e) {
-    throw SceneError(scene.file.string() + ": " + e.what());
+    throw SceneError(scene_.file.string() + ": " + e.what());
   }
   if (state != nullptr) {
     stepper_->set_clock(state->t, state->steps);

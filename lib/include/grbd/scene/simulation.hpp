@@ -72,13 +72,14 @@ inline constexpr double kBytesPerBody = 4096.0;
 /// pairs); a scene that cannot run throws SceneError before the first step.
 class Simulation {
  public:
-  /// Builds the scene and its initial bodies.
-  explicit Simulation(const Scene& scene);
+  /// Builds the scene and its initial bodies. The simulation keeps its own copy of the scene
+  /// (meshes are shared, not copied), so `Simulation sim(load_scene(path));` is safe.
+  explicit Simulation(Scene scene);
   /// Builds the scene and continues from `state` instead (restart); throws StateError when the
   /// state does not fit the scene: another number of groups, t and steps that do not agree with
   /// Δt, a material it does not have, a body that no group makes (shape, material, size, mass and
   /// inertia from its density or mass), or a body the system refuses.
-  Simulation(const Scene& scene, const SimulationState& state);
+  Simulation(Scene scene, const SimulationState& state);
   ~Simulation();
   Simulation(const Simulation&) = delete;
   Simulation& operator=(const Simulation&) = delete;
@@ -114,7 +115,7 @@ class Simulation {
   std::uint64_t inflow_backlog() const { return backlog_; }
 
  private:
-  Simulation(const Scene& scene, const SimulationState* state);
+  Simulation(Scene scene, const SimulationState* state);
   void restore(const SimulationState& state);
   void build_static();
   void generate_initial();
@@ -132,7 +133,7 @@ class Simulation {
   std::pair<double, std::size_t> static_gap(const BodyConstants& c, const body::State& x);
   struct Scratch;
 
-  const Scene& scene_;
+  const Scene scene_;
   timestep::MaterialTable materials_;
   timestep::StaticGeometry statics_;
   timestep::BodySystem system_;
