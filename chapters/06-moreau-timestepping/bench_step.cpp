@@ -1,5 +1,8 @@
 // Chapter 6: the cost of one Moreau step of a settled sphere pile (pile.hpp), by stage.
 //
+//   BM_hooks/n  the solve of the same pile without solver hooks, with a velocity hook and with an
+//               after_iteration hook that do nothing: velocity_hook_over_none and
+//               iteration_hook_over_none, the solve times against the one without, same run.
 //   BM_add/N    assembling N spheres: BodySystem::add (id check, validation) and
 //               CollisionWorld::add (the supported-pair check, O(1) per collider); seconds for N.
 //   BM_step/n   one step of the pile of n × n × n FCC cells (4n³ spheres, ≈ 6 contacts per
@@ -24,6 +27,7 @@
 #include <malloc.h>
 
 #include <chrono>
+#include <memory>
 #include <cstdlib>
 #include <span>
 #include <string_view>
@@ -149,6 +153,43 @@ void BM_step(benchmark::State& state) {
   state.counters["bytes_per_body"] = bytes / N;
 }
 
+// The cost of the solver's hooks: three copies of the pile stepped in turn, one without hooks,
+// one with a velocities_between_sweeps hook and one with an after_iteration hook, both doing
+// nothing; solve time of each against the one without, same run, same states.
+void BM_hooks(benchmark::State& state) {
+  const int n = static_cast<int>(state.range(0));
+  struct Pile {
+    timestep::BodySystem system;
+    timestep::StaticGeometry statics;
+    timestep::MaterialTable materials = demo::glass_materials();
+    std::unique_ptr<timestep::MoreauStepper> stepper;
+  };
+  std::vector<std::unique_ptr<Pile>> piles;
+  for (int kind = 0; kind < 3; ++kind) {
+    auto pile = std::make_unique<Pile>();
+    demo::fcc_pile(pile->system, pile->statics, n, n, n);
+    timestep::StepSettings settings;
+    settings.dt = 2e-4;
+    settings.solver.min_iterations = 100;
+    settings.solver.max_iterations = 100;
+    timestep::StepHooks hooks;
+    if (kind == 1) hooks.solver.velocities_between_sweeps = [](int, std::span<Vector6>) {};
+    if (kind == 2) {
+      hooks.solver.after_iteration = [](int, std::span<Vector3>, std::span<Vector6>) {};
+    }
+    pile->stepper = std::make_unique<timestep::MoreauStepper>(pile->system, pile->statics,
+                                                              pile->materials, settings, hooks);
+    for (int warm = 0; warm < 3; ++warm) pile->stepper->step();
+    piles.push_back(std::move(pile));
+  }
+  double solve[3] = {0.0, 0.0, 0.0};
+  for (auto _ : state) {
+    for (int kind = 0; kind < 3; ++kind) solve[kind] += piles[kind]->stepper->step().seconds.solve;
+  }
+  state.counters["velocity_hook_over_none"] = solve[1] / solve[0];
+  state.counters["iteration_hook_over_none"] = solve[2] / solve[0];
+}
+
 void BM_add(benchmark::State& state) {
   const auto n = static_cast<std::size_t>(state.range(0));
   double system_seconds = 0.0;
@@ -188,6 +229,7 @@ void BM_add(benchmark::State& state) {
 BENCHMARK(BM_add)->Arg(80000)->Arg(1000000)->Unit(benchmark::kMillisecond)->Iterations(1);
 BENCHMARK(BM_step)->Arg(6)->Arg(14)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_step)->Arg(29)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(3);
+BENCHMARK(BM_hooks)->Arg(14)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(5);
 
 // One step of the 63 × 63 × 63 pile, 1 000 188 spheres (about 10 GB with the body-form copy the
 // side-by-side comparison builds, and minutes to run): registered only when the environment
