@@ -39,6 +39,11 @@ numbers of the source (so Doxygen's warnings still point at the right line):
   row: the number must be a `\\demo{...}`. An introduction that says the table was "measured once"
   or made "once by hand" (MEASURED_ONCE: a benchmark measured once with a named program) exempts
   its table.
+- The experiments (demos that run for minutes: `--experiments=NAME,...`, their figure names and
+  data folders) are drawn by README command (1) only; where this build has not drawn one, its
+  figure becomes the stand-in `standin_NAME.svg` (book/CMakeLists.txt writes it), its caption
+  says so, and its `\\demo{NAME/values.txt#KEY}` values read "?". Every other missing figure or
+  value stays an error.
 - Every chapter gets previous/next links, at the top (in place of the blank line after the title)
   and at the bottom, following the order of the chapter folders; the last chapter leads to the
   bibliography.
@@ -273,8 +278,19 @@ def resolve_sections(lines: list[str], sections: set[str], path: pathlib.Path) -
     return out
 
 
+def stand_in(name: str, figure_dir: pathlib.Path | None, experiments: set[str]) -> bool:
+    """True when the figure NAME is an experiment's (a demo that runs for minutes, built by the
+    target `figures` of README command (1) only) and this build has not drawn it: the book then
+    shows the stand-in standin_NAME.svg that book/CMakeLists.txt writes."""
+    if name not in experiments or figure_dir is None:
+        return False
+    return not any((figure_dir / f"{name}.{ext}").exists() for ext in ("svg", "png"))
+
+
 def filter_chapter(path: pathlib.Path, text: str, sections: set[str] | None = None,
-                   figure_dir: pathlib.Path | None = None) -> str:
+                   figure_dir: pathlib.Path | None = None,
+                   experiments: set[str] | None = None) -> str:
+    experiments = experiments or set()
     m = chapter_heading(text)
     if not m:
         return text  # not a chapter page: leave it alone
@@ -327,6 +343,12 @@ def filter_chapter(path: pathlib.Path, text: str, sections: set[str] | None = No
                 line = book_error(f"the caption of {image.group('file')} writes the subscript "
                                   f"'{subscript}' as plain text: write it as a formula, "
                                   "\\f$...\\f$, as the text does", path, i + 1)
+            elif stand_in(name, figure_dir, experiments):
+                line = (f'{image.group("indent")}\\anchor {figure_anchor(name)} '
+                        f'\\image html standin_{name}.svg '
+                        f'"{figures[name]}: {caption_html(caption)} (A stand-in: this build '
+                        f'has not run the experiment, which ./scripts/demo runs; the figure is '
+                        f'not drawn by this build.)"{image.group("rest")}')
             else:
                 line = (f'{image.group("indent")}\\anchor {figure_anchor(name)} '
                         f'\\image html {image.group("file")} '
@@ -343,6 +365,9 @@ def filter_chapter(path: pathlib.Path, text: str, sections: set[str] | None = No
 
         def demo_value(ref: re.Match) -> str:
             values = demo_values(figure_dir, ref.group("file"))
+            folder = ref.group("file").split("/", 1)[0]
+            if values is None and stand_in(folder, figure_dir, experiments):
+                return "?"  # the experiment has not run: its figure is a stand-in too
             if values is None:
                 return book_error(f"\\demo{{{ref.group('file')}#{ref.group('key')}}}: no file "
                                   f"{ref.group('file')} in the figures folder {figure_dir} (run the "
@@ -367,22 +392,25 @@ def main() -> int:
     args = sys.argv[1:]
     sections: set[str] = set()
     figures: pathlib.Path | None = None
+    experiments: set[str] = set()
     while args and args[0].startswith("--"):
         option = args.pop(0)
         if option.startswith("--sections="):
             sections = {name for name in option[len("--sections="):].split(",") if name}
         elif option.startswith("--figures="):
             figures = pathlib.Path(option[len("--figures="):])
+        elif option.startswith("--experiments="):
+            experiments = {name for name in option[len("--experiments="):].split(",") if name}
         else:
             args = []
             break
     if len(args) != 1:
-        print("usage: book_filter.py [--sections=NAME,...] [--figures=DIR] <page.md>  (a Doxygen "
-              "INPUT_FILTER)", file=sys.stderr)
+        print("usage: book_filter.py [--sections=NAME,...] [--figures=DIR] [--experiments=NAME,...] "
+              "<page.md>  (a Doxygen INPUT_FILTER)", file=sys.stderr)
         return 2
     path = pathlib.Path(args[0])
     text = path.read_text(encoding="utf-8")
-    sys.stdout.write(filter_chapter(path, text, sections, figures))
+    sys.stdout.write(filter_chapter(path, text, sections, figures, experiments))
     return 0
 
 

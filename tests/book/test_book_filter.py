@@ -124,6 +124,42 @@ class DemoValues(unittest.TestCase):
         self.assertEqual(len(lines[:5]), 5)  # one line out per line in
 
 
+class Experiments(unittest.TestCase):
+    """The experiments (demos that run for minutes, README command (1) only) stand in where this
+    build has not run them; nothing else may be missing."""
+
+    def test_an_experiment_not_run_stands_in_and_one_that_ran_is_shown(self):
+        folder = tempfile.TemporaryDirectory(prefix="grbd_book_experiments_")
+        self.addCleanup(folder.cleanup)
+        figures = pathlib.Path(folder.name)
+        page = PAGE.split("\n")[0] + "\n\n" + "\n".join([
+            '\\image html ch07_heap.svg "A heap."',
+            "angle \\demo{ch07_heap/values.txt#angle} degrees",
+            '\\image html ch07_quick.svg "A quick one."',
+            "\\demo{ch07_quick/values.txt#n}"])
+        out = book_filter.filter_chapter(pathlib.Path("chapter.md"), page, set(), figures,
+                                         {"ch07_heap"}).split("\n")
+        self.assertIn("\\image html standin_ch07_heap.svg", out[2])
+        self.assertIn("not drawn by this build", out[2])
+        self.assertEqual(out[3], "angle ? degrees")
+        self.assertIn("\\image html ch07_quick.svg", out[4])  # Doxygen reports it missing
+        self.assertIn("BOOK ERROR: \\demo{ch07_quick/values.txt#n}: no file", out[5])
+        # Once the experiment has run, its own figure and values.
+        (figures / "ch07_heap.svg").write_text("<svg/>")
+        (figures / "ch07_heap").mkdir()
+        (figures / "ch07_heap" / "values.txt").write_text("angle = 22.9\n")
+        out = book_filter.filter_chapter(pathlib.Path("chapter.md"), page, set(), figures,
+                                         {"ch07_heap"}).split("\n")
+        self.assertIn("\\image html ch07_heap.svg", out[2])
+        self.assertEqual(out[3], "angle 22.9 degrees")
+        # A key the experiment did not write is an error even so.
+        (figures / "ch07_heap" / "values.txt").write_text("slope = 0.4\n")
+        out = book_filter.filter_chapter(pathlib.Path("chapter.md"), page, set(), figures,
+                                         {"ch07_heap"}).split("\n")
+        self.assertIn("BOOK ERROR: \\demo{ch07_heap/values.txt#angle}: the demo wrote no value",
+                      out[3])
+
+
 class DemoTables(unittest.TestCase):
     """A table introduced as a demo's output holds no number written by hand (issue: chapters 1-5
     copied the demos' tables into the text, and they drifted)."""
