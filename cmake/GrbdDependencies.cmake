@@ -56,12 +56,18 @@ grbd_require(CLI11_FOUND "CLI11 >= 2.1 (command lines)" libcli11-dev)
 find_package(tomlplusplus 3 QUIET CONFIG)
 grbd_require(tomlplusplus_FOUND "toml++ >= 3 (scene files)" libtomlplusplus-dev)
 
-find_package(benchmark QUIET)
-grbd_require(benchmark_FOUND "Google Benchmark" libbenchmark-dev)
+# The rest serves the book's project (GRBD_FULL_PROJECT: chapters, tests, book), not the library.
+if(GRBD_FULL_PROJECT)
+  find_package(benchmark QUIET)
+  grbd_require(benchmark_FOUND "Google Benchmark" libbenchmark-dev)
+endif()
 
-# Python 3 runs the exercise generator and the grading script (standard library only).
-find_package(Python3 QUIET COMPONENTS Interpreter)
-grbd_require(Python3_FOUND "Python 3" python3)
+# Python 3 runs the exercise generator, the grading script and the book's filter (standard
+# library only).
+if(GRBD_FULL_PROJECT OR GRBD_BUILD_TESTS OR GRBD_BUILD_BOOK)
+  find_package(Python3 QUIET COMPONENTS Interpreter)
+  grbd_require(Python3_FOUND "Python 3" python3)
+endif()
 
 # h5py and NumPy of Debian's own Python 3: chapter 7's tests and examples read output files as a
 # user does. The interpreter is /usr/bin/python3, where Debian's packages are installed (another
@@ -80,8 +86,10 @@ if(GRBD_BUILD_TESTS)
 endif()
 
 # gnuplot draws the figures of the chapters from the data the demo programs write.
-find_program(GRBD_GNUPLOT gnuplot)
-grbd_require(GRBD_GNUPLOT "gnuplot (the figures of the book)" gnuplot-nox)
+if(GRBD_FULL_PROJECT)
+  find_program(GRBD_GNUPLOT gnuplot)
+  grbd_require(GRBD_GNUPLOT "gnuplot (the figures of the book)" gnuplot-nox)
+endif()
 
 # Doxygen 1.9 and a local MathJax 2 for the book, which must render without a network.
 if(GRBD_BUILD_BOOK)

@@ -45,6 +45,7 @@
 #include "grbd/io/run.hpp"
 #include "grbd/scene/scene.hpp"
 #include "grbd/scene/simulation.hpp"
+#include "grbd/version.hpp"
 
 extern char** environ;  // POSIX: the environment, for posix_spawn
 

@@ -12,11 +12,8 @@
 #include <numeric>
 #include <sstream>
 
+#include "grbd/version.hpp"
 #include "io/h5util.hpp"
-
-#ifndef GRBD_VERSION
-#define GRBD_VERSION "unknown"
-#endif
 
 namespace grbd::io {
 
