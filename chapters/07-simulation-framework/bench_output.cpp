@@ -3,7 +3,8 @@
 //
 //   BM_output/N/P   N spheres of radius 1 mm in a simple-cubic lattice of touching spheres on a
 //                   floor (about 3 contacts per sphere, SOR with at most 100 iterations and warm
-//                   start), P = 0 double, 1 float32 records. Each iteration is one step and one
+//                   start), P = 0 double, 1 float32 records, 2 double records with their
+//                   contacts ([output] contacts). Each iteration is one step and one
 //                   record, timed apart. Counters:
 //                   step_ms      wall time of a step
 //                   record_ms    wall time of a record (write, flush, count, XDMF)
@@ -26,7 +27,7 @@
 
 namespace {
 
-std::string lattice_scene(std::int64_t n, bool float32) {
+std::string lattice_scene(std::int64_t n, bool float32, bool contacts) {
   // A square base of side k spheres holds the lattice in ⌈n / k²⌉ layers.
   std::int64_t k = 1;
   while (k * k * k < n) ++k;
@@ -62,14 +63,16 @@ kind = "lattice"
 count = )" +
          std::to_string(n) + "\nregion = { min = [0, 0, 0], max = [" + std::to_string(side) + ", " +
          std::to_string(side) + ", " + std::to_string(height) + "] }\n\n[output]\nprecision = \"" +
-         (float32 ? "float" : "double") + "\"\n";
+         (float32 ? "float" : "double") + "\"\ncontacts = " + (contacts ? "true" : "false") +
+         "\n";
 }
 
 void BM_output(benchmark::State& state) {
   const std::int64_t n = state.range(0);
-  const bool float32 = state.range(1) != 0;
+  const bool float32 = state.range(1) == 1;
+  const bool contacts = state.range(1) == 2;
   const grbd::scene::Scene scene =
-      grbd::scene::parse_scene(lattice_scene(n, float32), "bench_output.toml");
+      grbd::scene::parse_scene(lattice_scene(n, float32, contacts), "bench_output.toml");
   grbd::scene::Simulation sim(scene);
   const std::filesystem::path dir =
       std::filesystem::temp_directory_path() / ("grbd_bench_output_" + std::to_string(::getpid()));
@@ -112,6 +115,7 @@ BENCHMARK(BM_output)
     ->Args({10000, 0})
     ->Args({100000, 0})
     ->Args({100000, 1})
+    ->Args({100000, 2})
     ->Unit(benchmark::kMillisecond)
     ->UseManualTime()
     ->Iterations(3);

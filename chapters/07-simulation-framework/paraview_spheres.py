@@ -95,12 +95,15 @@ def main(argv):
         return 2
     from paraview import simple as pv  # noqa: E402 (only once the input is known to be there)
 
-    # The XDMF file holds two kinds of grid: one per record of the bodies (a temporal
-    # collection) and, where the scene has static geometry, the grid "static" of its triangles.
+    # The XDMF file holds a grid of the bodies per record (a temporal collection; with contacts,
+    # each record is a spatial collection of the bodies' and the contacts' grids) and, where the
+    # scene has static geometry, the grid "static" of its triangles.
     run = pv.XDMFReader(registrationName="run", FileNames=[xmf])
     run.UpdatePipelineInformation()
     grids = list(run.GetProperty("GridInfo")[::2]) if run.GetProperty("GridInfo") else []
-    run.GridStatus = [g for g in grids if g != "static"]
+    # The bodies only: not the static geometry, nor the contacts' lines of a run that writes them
+    # ([output] contacts), whose grids are named contacts, contacts[1], ...
+    run.GridStatus = [g for g in grids if g != "static" and not g.startswith("contacts")]
     times = list(run.TimestepValues) if run.TimestepValues else [0.0]
     record = int(argv[3]) if len(argv) == 4 else len(times) - 1
     if not 0 <= record < len(times):

@@ -285,6 +285,106 @@ class Output(Scratch):
             self.assertEqual(times, [f["records/time"][k] for k in with_bodies])
 
 
+COLUMN = """[simulation]
+dt = 1e-3
+end_time = 0.01
+[solver]
+tolerance = 1e-12
+max_iterations = 2000
+[[material]]
+name = "glass"
+[default_contact]
+mu = 0.5
+[[static]]
+name = "floor"
+shape = "half_space"
+normal = [0.0, 0.0, 1.0]
+material = "glass"
+[[bodies]]
+name = "column"
+radius = 0.01
+density = 2500.0
+material = "glass"
+positions = [[0.0, 0.0, 0.01], [0.0, 0.0, 0.03], [0.0, 0.0, 0.05], [0.0, 0.0, 0.07], [0.0, 0.0, 0.09]]
+[output]
+every = 5
+contacts = true
+"""
+
+
+class Contacts(Scratch):
+    """[output] contacts: each record holds the contacts of its step, checked against a column of
+    spheres at rest on a floor, whose k-th contact from the top carries λ_N = k m g Δt."""
+
+    def column(self, text=COLUMN):
+        scene = self.path("column.toml")
+        with open(scene, "w") as f:
+            f.write(text)
+        out = self.path("column.h5")
+        result = run("run", scene, "-q", "-o", out, "-c", self.path("column.ckpt.h5"))
+        self.assertEqual(result.returncode, 0, result.stderr)
+        return out
+
+    def test_a_column_of_spheres_carries_k_m_g_dt_at_its_kth_contact(self):
+        out = self.column()
+        m = 4.0 / 3.0 * np.pi * 0.01 ** 3 * 2500.0
+        static = 1 << 63  # the tag of a static object's id
+        with h5py.File(out, "r") as f:
+            self.assertEqual(list(f["records/contacts"]), [0, 5, 5])  # none before a step
+            self.assertEqual(f["records/000000/contacts/lambda_N"].shape, (0,))
+            for k in (1, 2):
+                c = f["records/%06d/contacts" % k]
+                ids = [tuple(int(i) for i in row) for row in c["ids"][()]]
+                # Sorted by key: (0, 1), (0, floor), (1, 2), (2, 3), (3, 4).
+                self.assertEqual(ids, [(0, 1), (0, static), (1, 2), (2, 3), (3, 4)])
+                below = {(0, 1): 4, (0, static): 5, (1, 2): 3, (2, 3): 2, (3, 4): 1}
+                expected = [below[i] * m * 9.81 * 1e-3 for i in ids]
+                # To the solver's tolerance (the column settles by 10⁻¹⁰ m/s in these steps).
+                np.testing.assert_allclose(c["lambda_N"][()], expected, rtol=1e-7)
+                self.assertLess(np.abs(c["lambda_T"][()]).max(), 1e-15)
+                # The normal points from side b to side a: down from the upper sphere, up from
+                # the floor.
+                np.testing.assert_allclose(c["normal"][()][:, 2], [-1, 1, -1, -1, -1], atol=1e-15)
+                np.testing.assert_allclose(c["point"][()][:, 2], [0.02, 0.0, 0.04, 0.06, 0.08],
+                                           atol=1e-6)
+                # A line per contact from side a to side b: the centres of the bodies, and the
+                # contact point on the floor.
+                line = c["line"][()]
+                np.testing.assert_allclose(line[:, 2], [0.01, 0.03, 0.01, 0.0, 0.03, 0.05,
+                                                        0.05, 0.07, 0.07, 0.09], atol=1e-6)
+                self.assertEqual(c["lambda_N"].attrs["unit"], "N s")
+                self.assertEqual(c["lambda_T"].attrs["frame"], "I")
+        # The XDMF: each record a spatial collection of bodies and contacts; every data item
+        # names a dataset of that shape.
+        tree = ET.parse(out[:-3] + ".xmf")
+        grids = tree.findall(".//Grid[@Name='contacts']")
+        self.assertEqual(len(grids), 2)
+        with h5py.File(out, "r") as f:
+            for grid in grids:
+                self.assertEqual(grid.find("Topology").get("TopologyType"), "Polyline")
+                for item in grid.iter("DataItem"):
+                    dataset = item.text.strip().split(":", 1)[1]
+                    dims = tuple(int(d) for d in item.get("Dimensions").split())
+                    self.assertEqual(f[dataset].shape, dims, dataset)
+
+    def test_a_restart_keeps_the_contacts_and_refuses_a_scene_that_changes_them(self):
+        reference = self.column()
+        os.rename(reference, self.path("ref.h5"))
+        os.rename(reference[:-3] + ".xmf", self.path("ref.xmf"))
+        scene = self.path("column.toml")
+        out, ckpt = self.path("column.h5"), self.path("column.ckpt.h5")
+        first = run("run", scene, "-q", "-o", out, "-c", ckpt, "--end-time", "0.007", "--force")
+        self.assertEqual(first.returncode, 0, first.stderr)
+        second = run("run", scene, "-q", "-o", out, "-c", ckpt, "--restart", ckpt)
+        self.assertEqual(second.returncode, 0, second.stderr)
+        self.assertSameOutput(self.path("ref.h5"), out)
+        with open(scene, "w") as f:
+            f.write(COLUMN.replace("contacts = true", "contacts = false"))
+        third = run("run", scene, "-q", "-o", out, "-c", ckpt, "--restart", ckpt)
+        self.assertNotEqual(third.returncode, 0)
+        self.assertIn("contacts", third.stderr)
+
+
 class Restart(Scratch):
     def test_n_steps_restart_n_steps_is_bit_identical_to_2n(self):
         reference = self.reference()

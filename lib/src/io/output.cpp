@@ -11,6 +11,7 @@
 #include <fstream>
 #include <numeric>
 #include <sstream>
+#include <type_traits>
 
 #include "grbd/version.hpp"
 #include "io/h5util.hpp"
@@ -200,12 +201,15 @@ struct OutputFile::Impl {
   Handle record_time;
   Handle record_step;
   Handle record_bodies;
+  Handle record_contacts;  // with [output] contacts: the contacts of each record
+  bool contacts = false;
   Handle body_type = h5::body_row_type();
   Handle step_type = h5::step_row_type();
   std::vector<h5::StepRow> pending_steps;
   // What the XDMF lists: time and body count of each complete record.
   std::vector<double> times;
   std::vector<std::uint64_t> counts;
+  std::vector<std::uint64_t> contact_counts;  // with [output] contacts
   // The static geometry's surface (/static): vertices and triangles, 0 when there is none.
   std::uint64_t static_points = 0;
   std::uint64_t static_triangles = 0;
@@ -213,6 +217,9 @@ struct OutputFile::Impl {
   std::fstream xdmf;
   std::streamoff xdmf_footer = 0;
   // Scratch of a record.
+  std::vector<std::uint32_t> contact_order;
+  std::vector<std::uint64_t> contact_ids, line_nodes;
+  std::vector<double> point, normal, gap, lambda_N, lambda_T, line;
   std::vector<std::size_t> order;
   std::vector<std::uint64_t> ids;
   std::vector<double> r, p, v, w, radius;
@@ -263,6 +270,13 @@ OutputFile::OutputFile(const std::filesystem::path& path, const scene::Scene& sc
   o.record_step = h5::create_table(o.records.get(), "step", H5T_STD_U64LE, 256, o.file);
   o.record_bodies = h5::create_table(o.records.get(), "bodies", H5T_STD_U64LE, 256, o.file);
   h5::write_attribute(o.records.get(), "count", std::uint64_t{0}, o.file);
+  o.contacts = scene.output.contacts;
+  h5::write_attribute(o.records.get(), "contacts", std::uint64_t{o.contacts ? 1u : 0u}, o.file);
+  if (o.contacts) {
+    o.record_contacts =
+        h5::create_table(o.records.get(), "contacts", H5T_STD_U64LE, 256, o.file);
+    h5::describe(o.records.get(), "contacts", "1", nullptr, o.file);
+  }
   h5::describe(o.records.get(), "time", "s", nullptr, o.file);
   h5::describe(o.records.get(), "step", "1", nullptr, o.file);
   h5::describe(o.records.get(), "bodies", "1", nullptr, o.file);
@@ -320,6 +334,14 @@ OutputFile::OutputFile(const std::filesystem::path& path, const scene::Scene& sc
   o.record_time = open_dataset(o.records.get(), "time", o.file);
   o.record_step = open_dataset(o.records.get(), "step", o.file);
   o.record_bodies = open_dataset(o.records.get(), "bodies", o.file);
+  o.contacts = H5Aexists(o.records.get(), "contacts") > 0 &&
+               h5::read_uint(o.records.get(), "contacts", o.file) != 0;
+  if (o.contacts != scene.output.contacts) {
+    h5::fail(o.file, std::string("was written ") + (o.contacts ? "with" : "without") +
+                         " the contacts of its records, the scene asks for the other ([output] "
+                         "contacts)");
+  }
+  if (o.contacts) o.record_contacts = open_dataset(o.records.get(), "contacts", o.file);
   const std::uint64_t count = h5::read_uint(o.records.get(), "count", o.file);
   if (count < at.records || h5::rows(o.steps.get(), o.file, "steps") < at.steps ||
       h5::rows(o.bodies.get(), o.file, "bodies") < at.bodies ||
@@ -340,6 +362,15 @@ OutputFile::OutputFile(const std::filesystem::path& path, const scene::Scene& sc
   h5::resize(o.record_time.get(), at.records, o.file, "records/time");
   h5::resize(o.record_step.get(), at.records, o.file, "records/step");
   h5::resize(o.record_bodies.get(), at.records, o.file, "records/bodies");
+  if (o.contacts) {
+    if (h5::rows(o.record_contacts.get(), o.file, "records/contacts") < at.records) {
+      h5::fail(o.file, "holds less than the checkpoint counts in records/contacts: it is not "
+                       "this run's output");
+    }
+    h5::resize(o.record_contacts.get(), at.records, o.file, "records/contacts");
+    h5::read_array(o.records.get(), "contacts", H5T_NATIVE_UINT64,
+                   static_cast<std::int64_t>(at.records), 0, o.contact_counts, o.file);
+  }
   h5::resize(o.steps.get(), at.steps, o.file, "steps");
   h5::resize(o.bodies.get(), at.bodies, o.file, "bodies");
   h5::read_array(o.records.get(), "time", H5T_NATIVE_DOUBLE, static_cast<std::int64_t>(at.records),
@@ -478,6 +509,7 @@ void OutputFile::write_record(scene::Simulation& simulation) {
   h5::describe(group.get(), "radius", "m", nullptr, o.file);
   h5::write_attribute(group.get(), "time", t, o.file);
   h5::write_attribute(group.get(), "step", step, o.file);
+  const std::uint64_t contacts = o.contacts ? write_contacts(group.get(), simulation) : 0;
   group.close();
   const std::uint64_t bodies = n;
   // The tables may hold rows of a record that a killed run did not count: overwrite them.
@@ -487,6 +519,11 @@ void OutputFile::write_record(scene::Simulation& simulation) {
   h5::append(o.record_time.get(), H5T_NATIVE_DOUBLE, &t, 1, o.file, "records/time");
   h5::append(o.record_step.get(), H5T_NATIVE_UINT64, &step, 1, o.file, "records/step");
   h5::append(o.record_bodies.get(), H5T_NATIVE_UINT64, &bodies, 1, o.file, "records/bodies");
+  if (o.contacts) {
+    h5::resize(o.record_contacts.get(), index, o.file, "records/contacts");
+    h5::append(o.record_contacts.get(), H5T_NATIVE_UINT64, &contacts, 1, o.file,
+               "records/contacts");
+  }
   // Everything of the record on disk first, then the count that makes it part of the file.
   check(H5Fflush(o.handle.get(), H5F_SCOPE_LOCAL), o.file, "cannot flush");
   h5::write_attribute(o.records.get(), "count", index + 1, o.file);
@@ -494,8 +531,80 @@ void OutputFile::write_record(scene::Simulation& simulation) {
   written_.records = index + 1;
   o.times.push_back(t);
   o.counts.push_back(bodies);
+  if (o.contacts) o.contact_counts.push_back(contacts);
   append_xdmf();
 }
+
+// [write contacts]
+std::uint64_t OutputFile::write_contacts(std::int64_t record, scene::Simulation& simulation) {
+  static_assert(std::is_same_v<hid_t, std::int64_t>);
+  Impl& o = *impl_;
+  const timestep::MoreauStepper& stepper = simulation.stepper();
+  const auto keys = stepper.keys();
+  const auto detected = stepper.contacts();
+  const auto lambda = stepper.percussions();
+  const auto& problem = stepper.problem().contacts;
+  // The last step's contacts (none before the first step), sorted by key.
+  const std::size_t m = stepper.steps() > 0 ? keys.size() : 0;
+  o.contact_order.resize(m);
+  std::iota(o.contact_order.begin(), o.contact_order.end(), std::uint32_t{0});
+  std::sort(o.contact_order.begin(), o.contact_order.end(),
+            [&](std::uint32_t a, std::uint32_t b) { return keys[a] < keys[b]; });
+  o.contact_ids.resize(2 * m);
+  o.point.resize(3 * m);
+  o.normal.resize(3 * m);
+  o.gap.resize(m);
+  o.lambda_N.resize(m);
+  o.lambda_T.resize(3 * m);
+  o.line.resize(6 * m);
+  o.line_nodes.resize(2 * m);
+  for (std::size_t j = 0; j < m; ++j) {
+    const std::size_t k = o.contact_order[j];
+    const collision::ContactGeometry& g = detected[k].geometry;
+    const contact::CompactContact& c = problem[k];
+    const Vector3 t2 = c.n.cross(c.t1);
+    const Vector3 tangential = lambda[k](1) * c.t1 + lambda[k](2) * t2;
+    // A line from side a to side b: a body's centre at the midpoint (contact point minus lever
+    // arm; a static object or fixed body has none, and its contact point stands in).
+    const Vector3 end_a = g.I_r_a - c.r_a, end_b = g.I_r_b - c.r_b;
+    o.contact_ids[2 * j] = keys[k].a;
+    o.contact_ids[2 * j + 1] = keys[k].b;
+    o.gap[j] = g.g_N;
+    o.lambda_N[j] = lambda[k](0);
+    for (int d = 0; d < 3; ++d) {
+      o.point[3 * j + d] = 0.5 * (g.I_r_a(d) + g.I_r_b(d));
+      o.normal[3 * j + d] = c.n(d);
+      o.lambda_T[3 * j + d] = tangential(d);
+      o.line[6 * j + d] = end_a(d);
+      o.line[6 * j + 3 + d] = end_b(d);
+    }
+    o.line_nodes[2 * j] = 2 * j;
+    o.line_nodes[2 * j + 1] = 2 * j + 1;
+  }
+  Handle group = check(H5Gcreate2(record, "contacts", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT),
+                       H5Gclose, o.file, "cannot create a record's contacts");
+  const hid_t g = group.get();
+  const hid_t real = o.float32 ? H5T_IEEE_F32LE : H5T_IEEE_F64LE;
+  h5::write_array(g, "ids", H5T_STD_U64LE, H5T_NATIVE_UINT64, m, 2, o.contact_ids.data(), o.file);
+  h5::write_array(g, "point", real, H5T_NATIVE_DOUBLE, m, 3, o.point.data(), o.file);
+  h5::write_array(g, "normal", real, H5T_NATIVE_DOUBLE, m, 3, o.normal.data(), o.file);
+  h5::write_array(g, "gap", real, H5T_NATIVE_DOUBLE, m, 0, o.gap.data(), o.file);
+  h5::write_array(g, "lambda_N", real, H5T_NATIVE_DOUBLE, m, 0, o.lambda_N.data(), o.file);
+  h5::write_array(g, "lambda_T", real, H5T_NATIVE_DOUBLE, m, 3, o.lambda_T.data(), o.file);
+  h5::write_array(g, "line", real, H5T_NATIVE_DOUBLE, 2 * m, 3, o.line.data(), o.file);
+  h5::write_array(g, "line_nodes", H5T_STD_U64LE, H5T_NATIVE_UINT64, m, 2, o.line_nodes.data(),
+                  o.file);
+  h5::describe(g, "ids", "1", nullptr, o.file);
+  h5::describe(g, "point", "m", "I", o.file);
+  h5::describe(g, "normal", "1", "I", o.file);
+  h5::describe(g, "gap", "m", nullptr, o.file);
+  h5::describe(g, "lambda_N", "N s", nullptr, o.file);
+  h5::describe(g, "lambda_T", "N s", "I", o.file);
+  h5::describe(g, "line", "m", "I", o.file);
+  h5::describe(g, "line_nodes", "1", nullptr, o.file);
+  return m;
+}
+// [write contacts]
 
 void OutputFile::close(scene::Simulation& simulation) {
   std::lock_guard lock(hdf5::mutex());
@@ -503,8 +612,8 @@ void OutputFile::close(scene::Simulation& simulation) {
   Impl& o = *impl_;
   write_bodies(simulation);
   write_steps();
-  for (Handle* h :
-       {&o.record_bodies, &o.record_step, &o.record_time, &o.records, &o.steps, &o.bodies}) {
+  for (Handle* h : {&o.record_contacts, &o.record_bodies, &o.record_step, &o.record_time,
+                    &o.records, &o.steps, &o.bodies}) {
     h->close();
   }
   if (!o.handle.close()) h5::fail(o.file, "cannot close the output file");
@@ -518,36 +627,66 @@ namespace {
 constexpr std::string_view kXdmfFooter = "  </Grid>\n </Domain>\n</Xdmf>\n";
 
 // The XDMF grid of record k with n bodies at time t: points with their radius, velocity,
-// angular velocity and id, all datasets of the record's HDF5 group.
+// angular velocity and id, all datasets of the record's HDF5 group. With contacts (m ≥ 0), the
+// record is a spatial collection of the bodies' grid and, when m > 0, the grid of its contacts:
+// a line per contact between the two sides, with its percussions and normal.
 void write_xdmf_grid(std::ostream& x, const std::string& h5_name, bool float32, std::uint64_t k,
-                     double t, std::uint64_t n) {
+                     double t, std::uint64_t n, bool contacts, std::uint64_t m) {
   const char* precision = float32 ? "4" : "8";
-  const std::string base = h5_name + ":/records/" + record_name(k) + "/";
+  const std::string record = h5_name + ":/records/" + record_name(k) + "/";
+  std::string base = record;
   auto item = [&](const std::string& dims, const char* type, const char* bytes,
                   const std::string& dataset) {
     x << "     <DataItem Dimensions=\"" << dims << "\" NumberType=\"" << type << "\" Precision=\""
       << bytes << "\" Format=\"HDF\">" << base << dataset << "</DataItem>\n";
   };
-  const std::string vector = std::to_string(n) + " 3";
-  const std::string scalar = std::to_string(n);
-  auto attribute = [&](const char* name, const char* kind, const std::string& dims,
-                       const char* type, const char* bytes, const std::string& dataset) {
-    x << "    <Attribute Name=\"" << name << "\" AttributeType=\"" << kind
-      << "\" Center=\"Node\">\n";
+  auto attribute = [&](const char* name, const char* kind, const char* center,
+                       const std::string& dims, const char* type, const char* bytes,
+                       const std::string& dataset) {
+    x << "    <Attribute Name=\"" << name << "\" AttributeType=\"" << kind << "\" Center=\""
+      << center << "\">\n";
     item(dims, type, bytes, dataset);
     x << "    </Attribute>\n";
   };
-  x << "   <Grid Name=\"record " << record_name(k) << "\" GridType=\"Uniform\">\n"
-    << "    <Time Value=\"" << t << "\"/>\n"
-    << "    <Topology TopologyType=\"Polyvertex\" NumberOfElements=\"" << n
+  const std::string vector = std::to_string(n) + " 3";
+  const std::string scalar = std::to_string(n);
+  if (contacts) {
+    x << "   <Grid Name=\"record " << record_name(k)
+      << "\" GridType=\"Collection\" CollectionType=\"Spatial\">\n"
+      << "    <Time Value=\"" << t << "\"/>\n"
+      << "   <Grid Name=\"bodies\" GridType=\"Uniform\">\n";
+  } else {
+    x << "   <Grid Name=\"record " << record_name(k) << "\" GridType=\"Uniform\">\n"
+      << "    <Time Value=\"" << t << "\"/>\n";
+  }
+  x << "    <Topology TopologyType=\"Polyvertex\" NumberOfElements=\"" << n
     << "\" NodesPerElement=\"1\"/>\n"
     << "    <Geometry GeometryType=\"XYZ\">\n";
   item(vector, "Float", precision, "I_r_S");
   x << "    </Geometry>\n";
-  attribute("radius", "Scalar", scalar, "Float", precision, "radius");
-  attribute("velocity", "Vector", vector, "Float", precision, "I_v_S");
-  attribute("angular_velocity_K", "Vector", vector, "Float", precision, "K_omega");
-  attribute("id", "Scalar", scalar, "UInt", "8", "id");
+  attribute("radius", "Scalar", "Node", scalar, "Float", precision, "radius");
+  attribute("velocity", "Vector", "Node", vector, "Float", precision, "I_v_S");
+  attribute("angular_velocity_K", "Vector", "Node", vector, "Float", precision, "K_omega");
+  attribute("id", "Scalar", "Node", scalar, "UInt", "8", "id");
+  x << "   </Grid>\n";
+  if (!contacts) return;
+  if (m > 0) {
+    base = record + "contacts/";
+    const std::string lines = std::to_string(m);
+    x << "   <Grid Name=\"contacts\" GridType=\"Uniform\">\n"
+      << "    <Topology TopologyType=\"Polyline\" NumberOfElements=\"" << m
+      << "\" NodesPerElement=\"2\">\n";
+    item(lines + " 2", "UInt", "8", "line_nodes");
+    x << "    </Topology>\n"
+      << "    <Geometry GeometryType=\"XYZ\">\n";
+    item(std::to_string(2 * m) + " 3", "Float", precision, "line");
+    x << "    </Geometry>\n";
+    attribute("lambda_N", "Scalar", "Cell", lines, "Float", precision, "lambda_N");
+    attribute("lambda_T", "Vector", "Cell", lines + " 3", "Float", precision, "lambda_T");
+    attribute("normal", "Vector", "Cell", lines + " 3", "Float", precision, "normal");
+    attribute("gap", "Scalar", "Cell", lines, "Float", precision, "gap");
+    x << "   </Grid>\n";
+  }
   x << "   </Grid>\n";
 }
 
@@ -587,7 +726,8 @@ void OutputFile::write_xdmf() {
     << "  <Grid Name=\"bodies\" GridType=\"Collection\" CollectionType=\"Temporal\">\n";
   for (std::size_t k = 0; k < o.times.size(); ++k) {
     if (o.counts[k] == 0) continue;  // ParaView cannot show an empty grid
-    write_xdmf_grid(x, h5_name, o.float32, k, o.times[k], o.counts[k]);
+    write_xdmf_grid(x, h5_name, o.float32, k, o.times[k], o.counts[k], o.contacts,
+                    o.contacts ? o.contact_counts[k] : 0);
   }
   x << kXdmfFooter;
   const std::string text = x.str();
@@ -606,7 +746,8 @@ void OutputFile::append_xdmf() {
   if (o.counts[k] == 0) return;  // ParaView cannot show an empty grid
   std::ostringstream x;
   x.precision(17);
-  write_xdmf_grid(x, o.path.filename().string(), o.float32, k, o.times[k], o.counts[k]);
+  write_xdmf_grid(x, o.path.filename().string(), o.float32, k, o.times[k], o.counts[k],
+                  o.contacts, o.contacts ? o.contact_counts[k] : 0);
   x << kXdmfFooter;
   const std::string text = x.str();
   o.xdmf.seekp(o.xdmf_footer);

@@ -731,6 +731,7 @@ void read_output(TableReader& t, Scene& scene) {
       static_cast<std::uint64_t>(t.integer("every", static_cast<std::int64_t>(scene.output.every),
                                            0, std::numeric_limits<std::int64_t>::max()));
   scene.output.float32 = t.choice("precision", {"double", "float"}, 0) == 1;
+  scene.output.contacts = t.boolean("contacts", false);
   t.finish();
 }
 

@@ -13,7 +13,10 @@
 ///   largest penetration, bodies, stage timings);
 /// - `/records/time`, `/records/step`, `/records/bodies`, and one group `/records/NNNNNN` per
 ///   record with `id`, `I_r_S`, `p`, `I_v_S`, `K_omega` and `radius`, rows in ascending global id;
-///   the attribute `/records@count` is the number of complete records;
+///   the attribute `/records@count` is the number of complete records; with `[output] contacts`,
+///   `/records/contacts` counts each record's contacts and its group `contacts` holds them
+///   (`ids`, `point`, `normal`, `gap`, `lambda_N`, `lambda_T`, and `line`, `line_nodes` for the
+///   XDMF's lines), rows sorted by contact key;
 /// - `/static`: the static geometry as triangles (`points`, `triangles`, `object`) and the
 ///   static objects' `names`, `shape` and `material` (see StaticSurface).
 ///
@@ -119,6 +122,8 @@ class OutputFile {
  private:
   struct Impl;
   void write_bodies(scene::Simulation& simulation);
+  // The group `contacts` of a record (with [output] contacts); returns their number.
+  std::uint64_t write_contacts(std::int64_t record, scene::Simulation& simulation);
   void write_steps();
   // The XDMF is written whole (atomically) when the file is created or reopened, and each record
   // is appended in place over its closing tags: O(1) per record, not O(records).

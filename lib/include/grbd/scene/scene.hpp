@@ -104,6 +104,9 @@ struct OutputSpec {
   std::filesystem::path file;  ///< the HDF5 file (empty: NAME.h5 in the working folder, NAME the scene file's stem)
   std::uint64_t every = 100;   ///< a record every this many steps (0: none but the first and last)
   bool float32 = false;        ///< q and u of the records in single precision
+  /// Each record also holds the contacts of the step that led to it (group `contacts`: the two
+  /// ids, point, normal, gap and percussions, sorted by key), drawn as lines in the XDMF.
+  bool contacts = false;
 };
 
 /// Checkpoints of the run.
