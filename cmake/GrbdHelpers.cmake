@@ -23,3 +23,17 @@ function(grbd_chapter_exercises chapter_dir out_var)
   list(SORT _ids COMPARE NATURAL)
   set(${out_var} ${_ids} PARENT_SCOPE)
 endfunction()
+
+# grbd_add_chapter_subdirectories(): add_subdirectory() for every chapter folder NN-topic of the
+# current source folder that has a CMakeLists.txt, in the order of their numbers: the chapters are
+# the folders, listed nowhere else (chapters/, tests/ and the book take them from there).
+function(grbd_add_chapter_subdirectories)
+  file(GLOB _dirs LIST_DIRECTORIES true RELATIVE ${CMAKE_CURRENT_SOURCE_DIR}
+       ${CMAKE_CURRENT_SOURCE_DIR}/[0-9][0-9]-*)
+  list(SORT _dirs)
+  foreach(_dir IN LISTS _dirs)
+    if(EXISTS ${CMAKE_CURRENT_SOURCE_DIR}/${_dir}/CMakeLists.txt)
+      add_subdirectory(${_dir})
+    endif()
+  endforeach()
+endfunction()

@@ -32,9 +32,9 @@ ROOT = pathlib.Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT / "scripts"))
 import grbd_exercises as gx  # noqa: E402
 
-CHAPTERS = ["ch01_kinematics", "ch02_rigid_bodies", "ch03_smooth_references", "ch04_collision",
-            "ch05_contact_laws", "ch06_moreau_timestepping", "ch07_simulation_framework",
-            "ch08_parallel_chute_flow"]
+# The chapter pages, from the chapter folders (chapters/NN-topic -> chNN_topic.html).
+CHAPTERS = ["ch" + folder.name.replace("-", "_")
+            for folder in sorted(ROOT.glob("chapters/[0-9][0-9]-*")) if (folder / "chapter.md").exists()]
 # Chapters that are written (not only an outline): they must quote code and show figures.
 WRITTEN = ["ch01_kinematics", "ch02_rigid_bodies", "ch03_smooth_references", "ch04_collision",
            "ch05_contact_laws", "ch06_moreau_timestepping", "ch07_simulation_framework"]

@@ -225,22 +225,24 @@ void Simulation::require_invertible_constants() const {
   }
 }
 
+namespace {
+// The bounding radius of a body of `group` whose radius (a sphere's, a capsule's segment's) is r.
+double group_bounding_radius(const BodyGroup& group, double r) {
+  BodyConstants body;
+  body.shape = group.shape;
+  body.radius = r;
+  body.half_extents = group.half_extents;
+  body.half_length = group.half_length;
+  return bounding_radius(body);
+}
+}  // namespace
+
 double largest_bounding_radius(const BodyGroup& group) {
-  BodyConstants largest;
-  largest.shape = group.shape;
-  largest.radius = group.radius.max();
-  largest.half_extents = group.half_extents;
-  largest.half_length = group.half_length;
-  return bounding_radius(largest);
+  return group_bounding_radius(group, group.radius.max());
 }
 
 double smallest_bounding_radius(const BodyGroup& group) {
-  BodyConstants smallest;
-  smallest.shape = group.shape;
-  smallest.radius = group.radius.min();
-  smallest.half_extents = group.half_extents;
-  smallest.half_length = group.half_length;
-  return bounding_radius(smallest);
+  return group_bounding_radius(group, group.radius.min());
 }
 
 // Buffers of the generators, kept between steps so that an inflow allocates nothing once warm.
