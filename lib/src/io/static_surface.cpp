@@ -4,6 +4,8 @@
 #include <cmath>
 #include <numbers>
 
+#include <Eigen/Geometry>
+
 #include "grbd/body/triangle_mesh.hpp"
 #include "grbd/collision/static_mesh.hpp"
 #include "grbd/io/output.hpp"
@@ -17,19 +19,6 @@ constexpr int kAround = 24;
 constexpr int kRings = 6;  // per hemisphere of a capsule
 constexpr int kSubdivisions = 2;
 
-struct Bounds {
-  Vector3 min = Vector3::Constant(std::numeric_limits<double>::infinity());
-  Vector3 max = Vector3::Constant(-std::numeric_limits<double>::infinity());
-  void add(const Vector3& p) {
-    min = min.cwiseMin(p);
-    max = max.cwiseMax(p);
-  }
-  void add(const Vector3& lo, const Vector3& hi) {
-    add(lo);
-    add(hi);
-  }
-  bool empty() const { return !(min.array() <= max.array()).all(); }
-};
 
 // The capsule of `radius` about the segment ±half_length e_z: a ring of kAround vertices per
 // latitude, kRings latitudes per hemisphere and the two poles; outward faces.
@@ -71,11 +60,11 @@ body::TriangleMesh capsule_mesh(double radius, double half_length) {
 
 // The polygon in which the plane nᵀx = offset cuts the box: its corners in counter-clockwise order
 // seen from the side n points to (none when the plane misses the box or only touches it).
-std::vector<Vector3> plane_in_box(const Vector3& n, double offset, const Bounds& box) {
+std::vector<Vector3> plane_in_box(const Vector3& n, double offset, const Eigen::AlignedBox3d& box) {
   std::vector<Vector3> corners;
   for (int c = 0; c < 8; ++c) {
-    corners.emplace_back(c & 1 ? box.max.x() : box.min.x(), c & 2 ? box.max.y() : box.min.y(),
-                         c & 4 ? box.max.z() : box.min.z());
+    corners.emplace_back(c & 1 ? box.max().x() : box.min().x(), c & 2 ? box.max().y() : box.min().y(),
+                         c & 4 ? box.max().z() : box.min().z());
   }
   std::vector<Vector3> points;
   for (int a = 0; a < 8; ++a) {
@@ -99,7 +88,7 @@ std::vector<Vector3> plane_in_box(const Vector3& n, double offset, const Bounds&
     return std::atan2(w.dot(p - centre), u.dot(p - centre)) <
            std::atan2(w.dot(q - centre), u.dot(q - centre));
   });
-  const double tiny = 1e-12 * (box.max - box.min).norm();
+  const double tiny = 1e-12 * box.diagonal().norm();
   std::vector<Vector3> polygon;
   for (const Vector3& p : points)
     if (polygon.empty() || (p - polygon.back()).norm() > tiny) polygon.push_back(p);
@@ -129,14 +118,14 @@ StaticSurface static_surface(const scene::Scene& scene) {
   StaticSurface surface;
   // Where the bodies can be: the outlet's box, else every region and position of the body groups
   // and the finite static objects, with a margin.
-  Bounds bounds;
+  Eigen::AlignedBox3d bounds;  // empty
   double largest_body = 0.0;
   for (const scene::BodyGroup& group : scene.groups) {
     const scene::GeneratorSpec& g = group.generator;
     if (g.kind == scene::GeneratorKind::list) {
-      for (const Vector3& p : g.positions) bounds.add(p);
+      for (const Vector3& p : g.positions) bounds.extend(p);
     } else {
-      bounds.add(g.region.min, g.region.max);
+      bounds.extend(g.region.min).extend(g.region.max);
     }
     const double size = group.shape == collision::ShapeKind::box
                             ? group.half_extents.norm()
@@ -145,7 +134,7 @@ StaticSurface static_surface(const scene::Scene& scene) {
                                                         : 0.0);
     largest_body = std::max(largest_body, size);
   }
-  auto add_finite = [&](const Vector3& lo, const Vector3& hi) { bounds.add(lo, hi); };
+  auto add_finite = [&](const Vector3& lo, const Vector3& hi) { bounds.extend(lo).extend(hi); };
   for (const scene::StaticSpec& s : scene.statics) {
     const collision::Placement& pose = s.pose;
     if (const auto* sphere = std::get_if<collision::Sphere>(&s.shape)) {
@@ -163,20 +152,18 @@ StaticSurface static_surface(const scene::Scene& scene) {
     }
   }
   if (scene.domain.enabled) {
-    bounds = Bounds{};
-    bounds.add(scene.domain.box.min, scene.domain.box.max);
-  } else if (!bounds.empty()) {
-    const double margin = std::max(0.05 * (bounds.max - bounds.min).maxCoeff(), 2.0 * largest_body);
-    bounds.min.array() -= margin;
-    bounds.max.array() += margin;
+    bounds = Eigen::AlignedBox3d(scene.domain.box.min, scene.domain.box.max);
+  } else if (!bounds.isEmpty()) {
+    const double margin = std::max(0.05 * bounds.sizes().maxCoeff(), 2.0 * largest_body);
+    bounds.min().array() -= margin;
+    bounds.max().array() += margin;
   }
-  if (bounds.empty() || !((bounds.max - bounds.min).array() > 0).all()) {
+  if (bounds.isEmpty() || !(bounds.sizes().array() > 0).all()) {
     // Nothing to size the planes by (or a flat box): a cube of 1 m about what there is.
-    const Vector3 centre = bounds.empty() ? Vector3::Zero() : Vector3(0.5 * (bounds.min + bounds.max));
-    bounds = Bounds{};
-    bounds.add(centre.array() - 0.5, centre.array() + 0.5);
+    const Vector3 centre = bounds.isEmpty() ? Vector3::Zero() : Vector3(bounds.center());
+    bounds = Eigen::AlignedBox3d(Vector3(centre.array() - 0.5), Vector3(centre.array() + 0.5));
   }
-  surface.bounds = {bounds.min, bounds.max};
+  surface.bounds = {bounds.min(), bounds.max()};
 
   auto append = [&](const body::TriangleMesh& m, const Matrix3& A, const Vector3& r,
                     std::uint32_t object) {
