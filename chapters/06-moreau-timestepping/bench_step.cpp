@@ -200,7 +200,7 @@ void BM_add(benchmark::State& state) {
     system.reserve(n);
     world.reserve(n + 1);
     world.add({collision::HalfSpace{}, collision::kStatic, Vector3::Zero(), Matrix3::Identity()});
-    timestep::BodySpec spec;
+    timestep::BodyRecord spec;
     spec.state.q << 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0;
     spec.state.u.setZero();
     spec.inertia = {1e-5, Vector3::Constant(4e-12)};

@@ -31,7 +31,7 @@ inline void fcc_pile(timestep::BodySystem& system, timestep::StaticGeometry& sta
     for (int j = 0; j < ny; ++j) {
       for (int i = 0; i < nx; ++i) {
         for (const Vector3& b : basis) {
-          timestep::BodySpec spec;
+          timestep::BodyRecord spec;
           spec.id = id++;
           spec.state.q << a * (Vector3(i, j, k) + b) + Vector3(0.0, 0.0, r * (1.0 - overlap)),
               1.0, 0.0, 0.0, 0.0;

@@ -1,6 +1,6 @@
 #pragma once
 // Chapter 6: the scenes of the validation cases, shared by the demo ch06_validation and the tests
-// (tests/06-moreau-timestepping): spheres and boxes of uniform density as BodySpecs, the floor and
+// (tests/06-moreau-timestepping): spheres and boxes of uniform density as BodyRecords, the floor and
 // other half-spaces, one-material tables, the tight solver settings of the closed-form checks,
 // tilted gravity for the incline, the Painlevé rod, and a jittered lattice of spheres in an open
 // box.
@@ -19,11 +19,11 @@
 namespace grbd::demo {
 
 /// A dynamic sphere of radius r and density ρ at I_r with velocity u.
-inline timestep::BodySpec sphere_body(timestep::GlobalId id, double r, const Vector3& I_r,
+inline timestep::BodyRecord sphere_body(timestep::GlobalId id, double r, const Vector3& I_r,
                                       const Vector6& u = Vector6::Zero(), double rho = 2500.0,
                                       timestep::MaterialId material = 0) {
   const body::MassProperties mp = body::sphere_mass_properties(r, rho);
-  timestep::BodySpec spec;
+  timestep::BodyRecord spec;
   spec.id = id;
   spec.state.q << I_r, 1.0, 0.0, 0.0, 0.0;
   spec.state.u = u;
@@ -34,10 +34,10 @@ inline timestep::BodySpec sphere_body(timestep::GlobalId id, double r, const Vec
 }
 
 /// A dynamic box of half extents h and density ρ at I_r, axes along I.
-inline timestep::BodySpec box_body(timestep::GlobalId id, const Vector3& h, const Vector3& I_r,
+inline timestep::BodyRecord box_body(timestep::GlobalId id, const Vector3& h, const Vector3& I_r,
                                    double rho = 1000.0) {
   const double m = rho * 8.0 * h.prod();
-  timestep::BodySpec spec;
+  timestep::BodyRecord spec;
   spec.id = id;
   spec.state.q << I_r, 1.0, 0.0, 0.0, 0.0;
   spec.state.u.setZero();
@@ -93,12 +93,12 @@ inline Vector3 tilted_gravity(double theta) {
 /// A uniform rod (a capsule of radius 1 cm and half length 0.5 m, 1 kg) leaning forward at 45°
 /// with its lower end touching the floor, sliding at 2 m/s: with μ = 1.5 > 4/3 it is in the
 /// Painlevé window of a rod (k = m l²/I = 3: μ > 2√(1 + k)/k; Stewart 2000).
-inline timestep::BodySpec painleve_rod() {
+inline timestep::BodyRecord painleve_rod() {
   const double l = 0.5;
   const double r = 0.01;
   const double m = 1.0;
   const double tilt = std::numbers::pi / 4.0;
-  timestep::BodySpec rod;
+  timestep::BodyRecord rod;
   rod.id = 1;
   rod.shape = collision::Capsule{r, l};
   rod.inertia = {m, Vector3(m * l * l / 3.0, m * l * l / 3.0, 1e-3 * m * r * r)};

@@ -54,7 +54,7 @@
 namespace {
 
 using namespace grbd;
-using timestep::BodySpec;
+using timestep::BodyRecord;
 using timestep::BodySystem;
 using timestep::GlobalId;
 using timestep::MaterialTable;
@@ -241,7 +241,7 @@ struct Slide {
   double omega_y = 0.0;
 };
 
-Slide slide(const BodySpec& spec, double theta, double mu, double t_end, double dt) {
+Slide slide(const BodyRecord& spec, double theta, double mu, double t_end, double dt) {
   BodySystem system;
   system.add(spec);
   StaticGeometry statics;
@@ -269,7 +269,7 @@ void inclines(const std::filesystem::path& dir) {
   const double dt = 1e-3;
   const double t_end = 1.0;
   const Vector3 h(0.1, 0.1, 0.05);
-  const BodySpec block = demo::box_body(1, h, Vector3(0.0, 0.0, h.z()));
+  const BodyRecord block = demo::box_body(1, h, Vector3(0.0, 0.0, h.z()));
   const Slide below = slide(block, theta_c - delta, mu, t_end, dt);
   const double theta = theta_c + delta;
   const double a = kG * (std::sin(theta) - mu * std::cos(theta));
@@ -303,7 +303,7 @@ void inclines(const std::filesystem::path& dir) {
   const double r = 0.05;
   const double theta_s = 20.0 * std::numbers::pi / 180.0;
   const double mu_roll = 2.0 / 7.0 * std::tan(theta_s);
-  const BodySpec ball = demo::sphere_body(1, r, Vector3(0.0, 0.0, r));
+  const BodyRecord ball = demo::sphere_body(1, r, Vector3(0.0, 0.0, r));
   const Slide roll = slide(ball, theta_s, 1.05 * mu_roll, t_end, dt);
   const double a_roll = 5.0 / 7.0 * kG * std::sin(theta_s);
   const Slide slip = slide(ball, theta_s, 0.95 * mu_roll, t_end, dt);
@@ -434,7 +434,7 @@ void half_steps() {
 
 void painleve() {
   for (const contact::Method method : {contact::Method::apgd, contact::Method::sor}) {
-    const BodySpec rod = demo::painleve_rod();
+    const BodyRecord rod = demo::painleve_rod();
     BodySystem system;
     system.add(rod);
     StaticGeometry statics;

@@ -119,7 +119,7 @@ struct Slide {
   double omega_y = 0.0;
 };
 
-Slide incline(const BodySpec& spec, double theta, double mu, double t_end, double dt = 1e-3) {
+Slide incline(const BodyRecord& spec, double theta, double mu, double t_end, double dt = 1e-3) {
   BodySystem system;
   system.add(spec);
   StaticGeometry statics;
@@ -138,7 +138,7 @@ TEST(Incline, ABlockSticksJustBelowTheFrictionAngleAndSlidesJustAbove) {
   const double theta_c = std::atan(mu);
   const double delta = 0.1 * std::numbers::pi / 180.0;
   const Vector3 h(0.1, 0.1, 0.05);
-  const BodySpec block = demo::box_body(1, h, Vector3(0.0, 0.0, h.z()));
+  const BodyRecord block = demo::box_body(1, h, Vector3(0.0, 0.0, h.z()));
   const double t = 1.0;
   const Slide stick = incline(block, theta_c - delta, mu, t);
   EXPECT_LE(std::abs(stick.x), 1e-12) << "creep below the friction angle";
@@ -152,7 +152,7 @@ TEST(Incline, ABlockSticksJustBelowTheFrictionAngleAndSlidesJustAbove) {
 
 TEST(Incline, ASphereRollsIffFrictionSufficesElseSlides) {
   const double r = 0.05;
-  const BodySpec ball = sphere_body(1, r, Vector3(0.0, 0.0, r));
+  const BodyRecord ball = sphere_body(1, r, Vector3(0.0, 0.0, r));
   const double theta = 20.0 * std::numbers::pi / 180.0;
   const double mu_roll = 2.0 / 7.0 * std::tan(theta);
   const double t = 1.0;
@@ -315,7 +315,7 @@ struct RodRun {
 RodRun slide_painleve_rod(contact::Method method) {
   // The rod of demo::painleve_rod() in the Painlevé window, where the acceleration-level
   // problem may have no solution or two (Stewart 2000); the velocity-level step always has one.
-  const BodySpec rod = demo::painleve_rod();
+  const BodyRecord rod = demo::painleve_rod();
   BodySystem system;
   system.add(rod);
   StaticGeometry statics;
@@ -688,7 +688,7 @@ TEST(Stepper, RefusesBadSettingsMissingMaterialPairsAndUnsupportedShapePairs) {
 // A blow-up is an error, not data: a step that leaves a state or an energy outside the doubles
 // throws, naming the step, the time and the body's id, whether or not the body has a contact.
 TEST(Stepper, AStepThatBlowsUpThrowsNamingStepTimeAndBody) {
-  const auto message_of_first_step = [](BodySpec spec, double dt, bool with_floor) {
+  const auto message_of_first_step = [](BodyRecord spec, double dt, bool with_floor) {
     BodySystem system;
     system.add(sphere_body(5, 0.1, Vector3(3.0, 0.0, 1.0)));  // a quiet neighbour
     system.add(spec);
@@ -703,17 +703,17 @@ TEST(Stepper, AStepThatBlowsUpThrowsNamingStepTimeAndBody) {
     }
     return std::string("no error");
   };
-  BodySpec spin = sphere_body(7, 0.1, Vector3(0.0, 0.0, 1.0));
+  BodyRecord spin = sphere_body(7, 0.1, Vector3(0.0, 0.0, 1.0));
   spin.state.u << 0.0, 0.0, 0.0, 1e308, 1e308, 0.0;  // |ω| overflows in the exponential map
   EXPECT_EQ(message_of_first_step(spin, 1.0, false).rfind(
                 "MoreauStepper: step 1 (t = 1 s): body 7 blew up", 0),
             0U) << message_of_first_step(spin, 1.0, false);
-  BodySpec fast = sphere_body(9, 0.1, Vector3(0.0, 0.0, 1.0));
+  BodyRecord fast = sphere_body(9, 0.1, Vector3(0.0, 0.0, 1.0));
   fast.state.u << 1e308, 0.0, 0.0, 0.0, 0.0, 0.0;  // finite, but q overflows in Δt = 10 s
   const std::string m = message_of_first_step(fast, 10.0, true);
   EXPECT_EQ(m.rfind("MoreauStepper: step 1 (t = 10 s): body 9 blew up", 0), 0U) << m;
   // Every body finite, but the system's energy overflows: named as such.
-  BodySpec heavy = sphere_body(11, 0.1, Vector3(0.0, 0.0, 1.0));
+  BodyRecord heavy = sphere_body(11, 0.1, Vector3(0.0, 0.0, 1.0));
   heavy.state.u << 1e154, 1e154, 1e154, 0.0, 0.0, 0.0;
   heavy.inertia.m = 1e10;
   heavy.inertia.K_Theta = Vector3::Constant(1e8);
@@ -742,7 +742,7 @@ TEST(Stepper, AStateSetFromOutsideThatIsNotFiniteIsNamedByItsId) {
 
 TEST(Stepper, RefusesBodiesWhoseMassOrInertiaHasNoFiniteInverse) {
   BodySystem system;
-  BodySpec tiny = sphere_body(1, 0.1, Vector3(0.0, 0.0, 1.0));
+  BodyRecord tiny = sphere_body(1, 0.1, Vector3(0.0, 0.0, 1.0));
   tiny.inertia.m = 5e-324;  // positive and finite, but 1/m = inf
   EXPECT_THROW(system.add(tiny), InvalidArgument);
   tiny = sphere_body(1, 0.1, Vector3(0.0, 0.0, 1.0));

@@ -95,13 +95,13 @@ TEST(BodySystem, MortonReorderDoesNotDependOnTheCurrentOrder) {
   BodySystem b;
   std::mt19937_64 rng(3);
   std::uniform_real_distribution<double> x(0.0, 1.0);
-  std::vector<BodySpec> specs;
+  std::vector<BodyRecord> specs;
   for (GlobalId id = 0; id < 500; ++id) {
     specs.push_back(sphere_body(id, 0.01, Vector3(x(rng), x(rng), x(rng))));
   }
-  for (const BodySpec& s : specs) a.add(s);
+  for (const BodyRecord& s : specs) a.add(s);
   std::shuffle(specs.begin(), specs.end(), rng);
-  for (const BodySpec& s : specs) b.add(s);
+  for (const BodyRecord& s : specs) b.add(s);
   a.reorder_morton(0.02);
   b.reorder_morton(0.02);
   ASSERT_EQ(a.size(), b.size());
@@ -118,18 +118,18 @@ TEST(BodySystem, MortonReorderDoesNotDependOnTheCurrentOrder) {
 TEST(BodySystem, RefusesBadBodiesNamingTheId) {
   BodySystem system = ten_spheres();
   EXPECT_NE(message_of([&] { system.add(sphere_body(103, 0.1, Vector3::Zero())); })
-                .find("global id 103 is already used by the body at local index 3"),
+                .find("global id 103 is already used by the owned body at local index 3"),
             std::string::npos);
   EXPECT_NE(message_of([&] { system.add(sphere_body(kStaticTag, 0.1, Vector3::Zero())); })
                 .find("below 2^63"),
             std::string::npos);
-  BodySpec bad = sphere_body(500, 0.1, Vector3::Zero());
+  BodyRecord bad = sphere_body(500, 0.1, Vector3::Zero());
   bad.state.q(3) = 2.0;  // |p| = 2
   EXPECT_NE(message_of([&] { system.add(bad); }).find("body 500"), std::string::npos);
-  BodySpec negative = sphere_body(501, 0.1, Vector3::Zero());
+  BodyRecord negative = sphere_body(501, 0.1, Vector3::Zero());
   negative.shape = collision::Sphere{-1.0};
   EXPECT_NE(message_of([&] { system.add(negative); }).find("sphere radius"), std::string::npos);
-  BodySpec plane = sphere_body(502, 0.1, Vector3::Zero());
+  BodyRecord plane = sphere_body(502, 0.1, Vector3::Zero());
   plane.shape = collision::HalfSpace{};
   EXPECT_NE(message_of([&] { system.add(plane); }).find("static objects"), std::string::npos);
   EXPECT_EQ(system.size(), 10u);  // nothing half-added
@@ -141,8 +141,8 @@ TEST(BodySystem, RefusesBadBodiesNamingTheId) {
 
 TEST(BodySystem, AFixedBodyHasNoVelocityAndNoInverseMass) {
   BodySystem system;
-  BodySpec spec = sphere_body(1, 0.1, Vector3::Zero(), Vector6::Ones());
-  spec.dynamic = false;
+  BodyRecord spec = sphere_body(1, 0.1, Vector3::Zero(), Vector6::Ones());
+  spec.flags = 0;  // fixed
   system.add(spec);
   EXPECT_FALSE(system.dynamic(0));
   EXPECT_EQ(system.states()[0].u, Vector6::Zero());

@@ -289,7 +289,7 @@ grbd::timestep::BodySystem spheres(const std::vector<grbd::Vector3>& centres,
                                    const std::vector<double>& speed = {}) {
   grbd::timestep::BodySystem system;
   for (std::size_t i = 0; i < centres.size(); ++i) {
-    grbd::timestep::BodySpec spec;
+    grbd::timestep::BodyRecord spec;
     spec.id = i;
     spec.state.q << centres[i], 1.0, 0.0, 0.0, 0.0;
     spec.state.u.setZero();
@@ -297,7 +297,7 @@ grbd::timestep::BodySystem spheres(const std::vector<grbd::Vector3>& centres,
     spec.inertia.m = 1.0;
     spec.inertia.K_Theta = grbd::Vector3::Constant(0.004);
     spec.shape = grbd::collision::Sphere{0.1};
-    spec.dynamic = !(i < fixed.size() && fixed[i]);
+    spec.flags = i < fixed.size() && fixed[i] ? 0 : grbd::timestep::kDynamic;
     system.add(spec);
   }
   return system;

@@ -57,8 +57,8 @@ double bounding_radius(const Shape& shape) {
   return 0.0;
 }
 
-void normalize_and_check(Shape& shape, std::string_view where_view) {
-  const std::string where(where_view);
+void normalize_and_check(Shape& shape, std::string_view where) {
+  // The messages are built only on failure: a valid shape is checked without allocating.
   switch (kind(shape)) {
     case ShapeKind::sphere:
       require_positive_finite(where, "sphere radius", std::get<Sphere>(shape).radius);
@@ -72,7 +72,7 @@ void normalize_and_check(Shape& shape, std::string_view where_view) {
       const Capsule& capsule = std::get<Capsule>(shape);
       require_positive_finite(where, "capsule radius", capsule.radius);
       if (!(capsule.half_length >= 0.0 && std::isfinite(capsule.half_length))) {
-        throw InvalidArgument(where + ": expected a finite capsule half length ≥ 0, found " +
+        throw InvalidArgument(std::string(where) + ": expected a finite capsule half length ≥ 0, found " +
                               format_number(capsule.half_length));
       }
       break;
@@ -81,7 +81,7 @@ void normalize_and_check(Shape& shape, std::string_view where_view) {
       HalfSpace& half_space = std::get<HalfSpace>(shape);
       const double norm = half_space.I_n.norm();
       if (!(norm > 0.0 && std::isfinite(norm) && std::isfinite(half_space.offset))) {
-        throw InvalidArgument(where +
+        throw InvalidArgument(std::string(where) +
                               ": expected a finite non-zero half-space normal and a "
                               "finite offset, found |I_n| = " +
                               format_number(norm) + ", offset " + format_number(half_space.offset));
@@ -93,7 +93,7 @@ void normalize_and_check(Shape& shape, std::string_view where_view) {
     }
     case ShapeKind::mesh:
       if (!std::get<std::shared_ptr<const StaticMesh>>(shape)) {
-        throw InvalidArgument(where + ": expected a mesh, found a null pointer");
+        throw InvalidArgument(std::string(where) + ": expected a mesh, found a null pointer");
       }
       break;
   }

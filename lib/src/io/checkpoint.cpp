@@ -68,17 +68,24 @@ std::uint64_t checksum(const Checkpoint& c) {
     sum.add(x);
   }
   sum.add(s.removed_mass);
-  for (std::size_t i = 0; i < s.bodies.size(); ++i) {
-    const h5::BodyRow row = h5::body_row(s.bodies[i]);
-    sum.add(row.id);
-    sum.add(std::uint64_t{row.shape} | std::uint64_t{row.fixed} << 8 |
-            std::uint64_t{row.material} << 16);
-    for (double x : {row.radius, row.half_extents[0], row.half_extents[1], row.half_extents[2],
-                     row.half_length, row.mass, row.K_Theta[0], row.K_Theta[1], row.K_Theta[2]}) {
-      sum.add(x);
+  // Each body as packed (timestep::pack): its id, one word of shape, fixed and material, then
+  // every double of the record in order, radius to u.
+  timestep::PackedBody bytes;
+  for (const timestep::BodyRecord& body : s.bodies) {
+    timestep::pack(body, bytes);
+    const auto word = [&]<class T>(std::size_t offset, T) {
+      T value;
+      std::memcpy(&value, bytes.data() + offset, sizeof(T));
+      return value;
+    };
+    namespace at = timestep::packed;
+    sum.add(word(at::id, std::uint64_t{}));
+    sum.add(std::uint64_t{word(at::shape, std::uint8_t{})} |
+            std::uint64_t{word(at::fixed, std::uint8_t{})} << 8 |
+            std::uint64_t{word(at::material, std::uint32_t{})} << 16);
+    for (std::size_t offset = at::radius; offset < timestep::kPackedBodyBytes; offset += 8) {
+      sum.add(word(offset, double{}));
     }
-    for (int d = 0; d < 7; ++d) sum.add(s.states[i].q[d]);
-    for (int d = 0; d < 6; ++d) sum.add(s.states[i].u[d]);
   }
   for (std::size_t k = 0; k < s.warm_keys.size(); ++k) {
     const timestep::ContactKey& key = s.warm_keys[k];
@@ -121,12 +128,12 @@ void write_temporary(const std::filesystem::path& temporary, const Checkpoint& c
     h5::write_attribute(root, "checksum", checksum(checkpoint), file);
 
     const std::size_t n = s.bodies.size();
-    std::vector<h5::BodyRow> rows(n);
+    std::vector<timestep::PackedBody> rows;
+    h5::pack_rows(s.bodies, rows);
     std::vector<double> states(13 * n);
     for (std::size_t i = 0; i < n; ++i) {
-      rows[i] = h5::body_row(s.bodies[i]);
-      for (int d = 0; d < 7; ++d) states[13 * i + d] = s.states[i].q[d];
-      for (int d = 0; d < 6; ++d) states[13 * i + 7 + d] = s.states[i].u[d];
+      for (int d = 0; d < 7; ++d) states[13 * i + d] = s.bodies[i].state.q[d];
+      for (int d = 0; d < 6; ++d) states[13 * i + 7 + d] = s.bodies[i].state.u[d];
     }
     Handle body_type = h5::body_row_type();
     h5::write_array(root, "bodies", h5::packed(body_type.get()).get(), body_type.get(), n, 0,
@@ -208,8 +215,8 @@ void require_consistent(const Checkpoint& c, const std::string& file) {
            "steps and next_id, found " + std::to_string(c.output.records) + ", " +
            std::to_string(c.output.steps) + ", " + std::to_string(c.output.bodies));
   }
-  for (std::size_t i = 0; i < s.states.size(); ++i) {
-    if (!s.states[i].q.allFinite() || !s.states[i].u.allFinite()) {
+  for (std::size_t i = 0; i < s.bodies.size(); ++i) {
+    if (!s.bodies[i].state.q.allFinite() || !s.bodies[i].state.u.allFinite()) {
       refuse("dataset states, row " + std::to_string(i) + " (body " +
              std::to_string(s.bodies[i].id) + "): not finite");
     }
@@ -262,23 +269,26 @@ Checkpoint read_checkpoint(const std::filesystem::path& path) {
   c.output.steps = h5::read_uint(root, "output_steps", file);
   c.output.bodies = h5::read_uint(root, "output_bodies", file);
 
-  std::vector<h5::BodyRow> rows;
+  std::vector<timestep::PackedBody> rows;
   Handle body_type = h5::body_row_type();
   const std::uint64_t n = h5::read_array(root, "bodies", body_type.get(), -1, 0, rows, file);
   std::vector<double> states;
   h5::read_array(root, "states", H5T_NATIVE_DOUBLE, static_cast<std::int64_t>(n), 13, states, file);
   s.bodies.resize(n);
-  s.states.resize(n);
   for (std::uint64_t i = 0; i < n; ++i) {
-    const h5::BodyRow& row = rows[i];
-    if (row.shape > static_cast<std::uint8_t>(collision::ShapeKind::capsule) || row.fixed > 1 ||
-        row.id >= s.next_id) {
-      h5::fail(file, "dataset bodies, row " + std::to_string(i) +
-                         ": expected a shape 0–2, fixed 0 or 1 and an id below next_id");
+    timestep::BodyRecord& body = s.bodies[i];
+    try {
+      body = timestep::unpack(rows[i]);
+    } catch (const InvalidArgument& e) {
+      h5::fail(file, "dataset bodies, row " + std::to_string(i) + ": " + e.what());
     }
-    s.bodies[i] = h5::body_constants(row);
-    for (int d = 0; d < 7; ++d) s.states[i].q[d] = states[13 * i + d];
-    for (int d = 0; d < 6; ++d) s.states[i].u[d] = states[13 * i + 7 + d];
+    if (body.id >= s.next_id) {
+      h5::fail(file, "dataset bodies, row " + std::to_string(i) + ": expected an id below "
+                     "next_id = " + std::to_string(s.next_id) + ", found " +
+                     std::to_string(body.id));
+    }
+    for (int d = 0; d < 7; ++d) body.state.q[d] = states[13 * i + d];
+    for (int d = 0; d < 6; ++d) body.state.u[d] = states[13 * i + 7 + d];
   }
   std::vector<std::uint64_t> keys;
   const std::uint64_t m =

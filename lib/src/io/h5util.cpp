@@ -23,46 +23,10 @@ Handle string_type(const std::string& file) {
   return type;
 }
 
-BodyRow body_row(const scene::BodyConstants& body) {
-  BodyRow row{};
-  row.id = body.id;
-  row.shape = static_cast<std::uint8_t>(body.shape);
-  row.fixed = body.fixed ? 1 : 0;
-  row.material = body.material;
-  row.radius = body.radius;
-  row.half_length = body.half_length;
-  row.mass = body.inertia.m;
-  for (int d = 0; d < 3; ++d) {
-    row.half_extents[d] = body.half_extents[d];
-    row.K_Theta[d] = body.inertia.K_Theta[d];
-  }
-  return row;
-}
-
-scene::BodyConstants body_constants(const BodyRow& row) {
-  scene::BodyConstants body;
-  body.id = row.id;
-  body.shape = static_cast<collision::ShapeKind>(row.shape);
-  body.fixed = row.fixed != 0;
-  body.material = row.material;
-  body.radius = row.radius;
-  body.half_length = row.half_length;
-  body.inertia.m = row.mass;
-  for (int d = 0; d < 3; ++d) {
-    body.half_extents[d] = row.half_extents[d];
-    body.inertia.K_Theta[d] = row.K_Theta[d];
-  }
-  return body;
-}
-
-bool same_constants(const BodyRow& a, const BodyRow& b) {
-  const auto same = [](const double* x, const double* y, int n) {
-    return std::memcmp(x, y, static_cast<std::size_t>(n) * sizeof(double)) == 0;
-  };
-  return a.id == b.id && a.shape == b.shape && a.fixed == b.fixed && a.material == b.material &&
-         same(&a.radius, &b.radius, 1) && same(a.half_extents, b.half_extents, 3) &&
-         same(&a.half_length, &b.half_length, 1) && same(&a.mass, &b.mass, 1) &&
-         same(a.K_Theta, b.K_Theta, 3);
+void pack_rows(std::span<const timestep::BodyRecord> records,
+               std::vector<timestep::PackedBody>& rows) {
+  rows.resize(records.size());
+  for (std::size_t i = 0; i < records.size(); ++i) timestep::pack(records[i], rows[i]);
 }
 
 void require_regular_file(const std::filesystem::path& path, const std::string& what) {
@@ -72,18 +36,19 @@ void require_regular_file(const std::filesystem::path& path, const std::string& 
 }
 
 Handle body_row_type() {
-  Handle type(H5Tcreate(H5T_COMPOUND, sizeof(BodyRow)), H5Tclose);
+  namespace at = timestep::packed;
+  Handle type(H5Tcreate(H5T_COMPOUND, timestep::kPackedBodyBytes), H5Tclose);
   const hsize_t three = 3;
   Handle vector3(H5Tarray_create2(H5T_NATIVE_DOUBLE, 1, &three), H5Tclose);
-  H5Tinsert(type.get(), "id", HOFFSET(BodyRow, id), H5T_NATIVE_UINT64);
-  H5Tinsert(type.get(), "shape", HOFFSET(BodyRow, shape), H5T_NATIVE_UINT8);
-  H5Tinsert(type.get(), "fixed", HOFFSET(BodyRow, fixed), H5T_NATIVE_UINT8);
-  H5Tinsert(type.get(), "material", HOFFSET(BodyRow, material), H5T_NATIVE_UINT32);
-  H5Tinsert(type.get(), "radius", HOFFSET(BodyRow, radius), H5T_NATIVE_DOUBLE);
-  H5Tinsert(type.get(), "half_extents", HOFFSET(BodyRow, half_extents), vector3.get());
-  H5Tinsert(type.get(), "half_length", HOFFSET(BodyRow, half_length), H5T_NATIVE_DOUBLE);
-  H5Tinsert(type.get(), "mass", HOFFSET(BodyRow, mass), H5T_NATIVE_DOUBLE);
-  H5Tinsert(type.get(), "K_Theta", HOFFSET(BodyRow, K_Theta), vector3.get());
+  H5Tinsert(type.get(), "id", at::id, H5T_NATIVE_UINT64);
+  H5Tinsert(type.get(), "shape", at::shape, H5T_NATIVE_UINT8);
+  H5Tinsert(type.get(), "fixed", at::fixed, H5T_NATIVE_UINT8);
+  H5Tinsert(type.get(), "material", at::material, H5T_NATIVE_UINT32);
+  H5Tinsert(type.get(), "radius", at::radius, H5T_NATIVE_DOUBLE);
+  H5Tinsert(type.get(), "half_extents", at::half_extents, vector3.get());
+  H5Tinsert(type.get(), "half_length", at::half_length, H5T_NATIVE_DOUBLE);
+  H5Tinsert(type.get(), "mass", at::mass, H5T_NATIVE_DOUBLE);
+  H5Tinsert(type.get(), "K_Theta", at::K_Theta, vector3.get());
   return type;
 }
 
@@ -308,8 +273,10 @@ template std::uint64_t read_array<double>(hid_t, const char*, hid_t, std::int64_
 template std::uint64_t read_array<std::uint64_t>(hid_t, const char*, hid_t, std::int64_t,
                                                  std::uint64_t, std::vector<std::uint64_t>&,
                                                  const std::string&);
-template std::uint64_t read_array<BodyRow>(hid_t, const char*, hid_t, std::int64_t, std::uint64_t,
-                                           std::vector<BodyRow>&, const std::string&);
+template std::uint64_t read_array<timestep::PackedBody>(hid_t, const char*, hid_t, std::int64_t,
+                                                        std::uint64_t,
+                                                        std::vector<timestep::PackedBody>&,
+                                                        const std::string&);
 template std::uint64_t read_array<StepRow>(hid_t, const char*, hid_t, std::int64_t, std::uint64_t,
                                            std::vector<StepRow>&, const std::string&);
 

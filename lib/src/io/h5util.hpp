@@ -6,11 +6,13 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <span>
 #include <string>
 #include <vector>
 
 #include "core/hdf5.hpp"
 #include "grbd/io/output.hpp"
+#include "grbd/timestep/body_record.hpp"
 
 namespace grbd::io::h5 {
 
@@ -33,24 +35,9 @@ inline void check(herr_t status, const std::string& file, const std::string& wha
 /// A variable-length UTF-8 string type (attributes and string datasets).
 Handle string_type(const std::string& file);
 
-/// One row of /bodies (output) and of a checkpoint's /bodies.
-struct BodyRow {
-  std::uint64_t id;
-  std::uint8_t shape;  // 0 sphere, 1 box, 2 capsule (collision::ShapeKind)
-  std::uint8_t fixed;
-  std::uint32_t material;
-  double radius;
-  double half_extents[3];
-  double half_length;
-  double mass;
-  double K_Theta[3];
-};
-
-/// The row of a body's constants, and the constants of a row (as written).
-BodyRow body_row(const scene::BodyConstants& body);
-scene::BodyConstants body_constants(const BodyRow& row);
-/// Whether two rows hold the same body (every field equal, bit for bit for the numbers).
-bool same_constants(const BodyRow& a, const BodyRow& b);
+/// Packs records into `rows` (resized), for the tables /bodies of the output and a checkpoint.
+void pack_rows(std::span<const timestep::BodyRecord> records,
+               std::vector<timestep::PackedBody>& rows);
 /// Throws IoError naming `path` ("no such <what>", "not a regular file") unless it is a regular
 /// file (a FIFO or a device would block or never end).
 void require_regular_file(const std::filesystem::path& path, const std::string& what);
@@ -76,7 +63,8 @@ struct StepRow {
   double seconds_total;
 };
 
-/// The compound types of the rows in memory (with the struct's padding).
+/// The compound types of the rows in memory: a body's is a packed timestep::BodyRecord, whose
+/// constants are the columns (its state is not), a step's the struct StepRow.
 Handle body_row_type();
 Handle step_row_type();
 /// A packed copy of a compound type: what goes into the file, without padding bytes.

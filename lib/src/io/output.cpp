@@ -95,20 +95,27 @@ Handle open_output(const std::filesystem::path& path, unsigned mode, hid_t acces
 // Every body of the checkpoint must have its row, the same constants, among the first `rows`
 // rows of /bodies: else the output belongs to another run.
 void check_bodies(hid_t root, const std::string& file, std::uint64_t rows,
-                  std::span<const scene::BodyConstants> bodies) {
-  std::vector<h5::BodyRow> table;
+                  std::span<const timestep::BodyRecord> bodies) {
+  std::vector<timestep::PackedBody> packed;
   Handle type = h5::body_row_type();
-  h5::read_array(root, "bodies", type.get(), -1, 0, table, file);
-  table.resize(std::min<std::size_t>(table.size(), rows));
+  h5::read_array(root, "bodies", type.get(), -1, 0, packed, file);
+  packed.resize(std::min<std::size_t>(packed.size(), rows));
+  std::vector<timestep::BodyRecord> table;
+  table.reserve(packed.size());
+  for (std::size_t i = 0; i < packed.size(); ++i) {
+    try {
+      table.push_back(timestep::unpack(packed[i]));
+    } catch (const InvalidArgument& e) {
+      h5::fail(file, "dataset bodies, row " + std::to_string(i) + ": " + e.what());
+    }
+  }
   std::sort(table.begin(), table.end(),
-            [](const h5::BodyRow& a, const h5::BodyRow& b) { return a.id < b.id; });
-  for (const scene::BodyConstants& body : bodies) {
-    const h5::BodyRow expected = h5::body_row(body);
+            [](const timestep::BodyRecord& a, const timestep::BodyRecord& b) { return a.id < b.id; });
+  for (const timestep::BodyRecord& body : bodies) {
     const auto it = std::lower_bound(
         table.begin(), table.end(), body.id,
-        [](const h5::BodyRow& row, std::uint64_t id) { return row.id < id; });
-    if (it == table.end() || it->id != body.id ||
-        !h5::same_constants(*it, expected)) {
+        [](const timestep::BodyRecord& row, std::uint64_t id) { return row.id < id; });
+    if (it == table.end() || it->id != body.id || !timestep::same_constants(*it, body)) {
       h5::fail(file, "belongs to another run: the body with id " + std::to_string(body.id) +
                          " of the checkpoint is " +
                          (it == table.end() || it->id != body.id ? "not in its table /bodies"
@@ -206,6 +213,7 @@ struct OutputFile::Impl {
   Handle body_type = h5::body_row_type();
   Handle step_type = h5::step_row_type();
   std::vector<h5::StepRow> pending_steps;
+  std::vector<timestep::PackedBody> packed_bodies;  // rows of /bodies being written
   // What the XDMF lists: time and body count of each complete record.
   std::vector<double> times;
   std::vector<std::uint64_t> counts;
@@ -420,11 +428,10 @@ void OutputFile::add_step(const timestep::StepReport& report, std::size_t bodies
 
 void OutputFile::write_bodies(scene::Simulation& simulation) {
   Impl& o = *impl_;
-  std::vector<scene::BodyConstants>& created = simulation.created();
+  std::vector<timestep::BodyRecord>& created = simulation.created();
   if (created.empty()) return;
-  std::vector<h5::BodyRow> rows;
-  rows.reserve(created.size());
-  for (const scene::BodyConstants& c : created) rows.push_back(h5::body_row(c));
+  h5::pack_rows(created, o.packed_bodies);
+  const auto& rows = o.packed_bodies;
   h5::append(o.bodies.get(), o.body_type.get(), rows.data(), rows.size(), o.file, "bodies");
   written_.bodies += rows.size();
   created.clear();

@@ -173,8 +173,8 @@ RunResult run(const scene::Scene& scene, const RunOptions& options) {
     } else {
       // A new output: its body table starts with every body of the checkpoint.
       output = std::make_unique<OutputFile>(options.output, scene);
-      for (std::size_t i = 0; i < simulation->system().size(); ++i) {
-        simulation->created().push_back(simulation->constants(i));
+      for (std::size_t i = 0; i < simulation->system().owned_count(); ++i) {
+        simulation->created().push_back(simulation->system().record(i));
       }
     }
   } else {

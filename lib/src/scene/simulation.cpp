@@ -23,36 +23,20 @@
 
 namespace grbd::scene {
 
-collision::Shape shape_of(const BodyConstants& body) {
-  switch (body.shape) {
-    case collision::ShapeKind::box:
-      return collision::Box{body.half_extents};
-    case collision::ShapeKind::capsule:
-      return collision::Capsule{body.radius, body.half_length};
-    default:
-      return collision::Sphere{body.radius};
-  }
-}
-
 namespace {
 
 using collision::ShapeKind;
 
-// The radius of the sphere about S that holds the body.
-double bounding_radius(const BodyConstants& body) {
-  return collision::bounding_radius(shape_of(body));
-}
+using timestep::BodyRecord;
 
-// The body a spec describes, in the state x.
-timestep::BodySpec spec_of(const BodyConstants& body, const body::State& x) {
-  timestep::BodySpec spec;
-  spec.id = body.id;
-  spec.state = x;
-  spec.inertia = body.inertia;
-  spec.shape = shape_of(body);
-  spec.material = body.material;
-  spec.dynamic = !body.fixed;
-  return spec;
+// The radius of the sphere about S that holds the body.
+double bounding_radius(const BodyRecord& body) { return collision::bounding_radius(body.shape); }
+
+// The radius of a sphere or a capsule (0 for a box): what a group's distribution draws.
+double radius_of(const BodyRecord& body) {
+  if (const auto* sphere = std::get_if<collision::Sphere>(&body.shape)) return sphere->radius;
+  if (const auto* capsule = std::get_if<collision::Capsule>(&body.shape)) return capsule->radius;
+  return 0.0;
 }
 
 // A uniformly distributed unit quaternion (Shoemake 1992, "Uniform random rotations").
@@ -203,7 +187,7 @@ void Simulation::require_invertible_constants() const {
   for (std::size_t g = 0; g < scene_.groups.size(); ++g) {
     const BodyGroup& group = scene_.groups[g];
     for (const double r : {group.radius.min(), group.radius.max()}) {
-      const BodyConstants c = constants_for(group, r);
+      const BodyRecord c = body_for(group, r);
       try {
         body::require_valid(c.inertia, "");  // the rule BodySystem::add applies to every body
         continue;
@@ -228,12 +212,14 @@ void Simulation::require_invertible_constants() const {
 namespace {
 // The bounding radius of a body of `group` whose radius (a sphere's, a capsule's segment's) is r.
 double group_bounding_radius(const BodyGroup& group, double r) {
-  BodyConstants body;
-  body.shape = group.shape;
-  body.radius = r;
-  body.half_extents = group.half_extents;
-  body.half_length = group.half_length;
-  return bounding_radius(body);
+  switch (group.shape) {
+    case ShapeKind::box:
+      return collision::bounding_radius(collision::Box{group.half_extents});
+    case ShapeKind::capsule:
+      return collision::bounding_radius(collision::Capsule{r, group.half_length});
+    default:
+      return collision::bounding_radius(collision::Sphere{r});
+  }
 }
 }  // namespace
 
@@ -256,9 +242,8 @@ struct Simulation::Scratch {
 
 Simulation::~Simulation() = default;
 
-std::pair<double, std::size_t> Simulation::static_gap(const BodyConstants& c,
+std::pair<double, std::size_t> Simulation::static_gap(const collision::Shape& shape,
                                                       const body::State& x) {
-  const collision::Shape shape = shape_of(c);
   const collision::Placement pose{kinematics::position(x.q),
                                   kinematics::rotation_matrix(kinematics::orientation(x.q))};
   double gap = std::numeric_limits<double>::infinity();
@@ -372,25 +357,23 @@ void Simulation::check_shapes() const {
   }
 }
 
-BodyConstants Simulation::constants_for(const BodyGroup& g, double radius) const {
-  BodyConstants c;
-  c.shape = g.shape;
+BodyRecord Simulation::body_for(const BodyGroup& g, double radius) const {
+  BodyRecord c;
   c.material = *materials_.find(g.material);
-  c.fixed = g.fixed;
+  c.flags = g.fixed ? 0 : timestep::kDynamic;
   body::MassProperties mass;
   switch (g.shape) {
     case ShapeKind::box:
-      c.half_extents = g.half_extents;
+      c.shape = collision::Box{g.half_extents};
       mass = body::box_mass_properties(g.half_extents, 1.0);
       break;
     case ShapeKind::capsule:
-      c.radius = radius;
-      c.half_length = g.half_length;
-      mass = body::capsule_mass_properties(c.radius, 2.0 * g.half_length, 1.0);
+      c.shape = collision::Capsule{radius, g.half_length};
+      mass = body::capsule_mass_properties(radius, 2.0 * g.half_length, 1.0);
       break;
     default:
-      c.radius = radius;
-      mass = body::sphere_mass_properties(c.radius, 1.0);
+      c.shape = collision::Sphere{radius};
+      mass = body::sphere_mass_properties(radius, 1.0);
       break;
   }
   // Unit density first, then scaled: by the density, or to the given mass.
@@ -400,33 +383,17 @@ BodyConstants Simulation::constants_for(const BodyGroup& g, double radius) const
   return c;
 }
 
-BodyConstants Simulation::make_constants(std::size_t group, Random& random) {
+BodyRecord Simulation::make_body(std::size_t group, Random& random) {
   const BodyGroup& g = scene_.groups[group];
-  BodyConstants c = constants_for(g, g.shape == ShapeKind::box ? 0.0 : g.radius.sample(random));
+  BodyRecord c = body_for(g, g.shape == ShapeKind::box ? 0.0 : g.radius.sample(random));
   c.id = next_id_;
   return c;
 }
 
-void Simulation::add_body(const BodyConstants& constants, const body::State& state) {
-  system_.add(spec_of(constants, state));
-  created_.push_back(constants);
-}
-
-BodyConstants Simulation::constants(std::size_t i) const {
-  BodyConstants c;
-  c.id = system_.ids()[i];
-  const collision::Shape& shape = system_.shapes()[i];
-  c.shape = collision::kind(shape);
-  if (const auto* s = std::get_if<collision::Sphere>(&shape)) c.radius = s->radius;
-  if (const auto* b = std::get_if<collision::Box>(&shape)) c.half_extents = b->half_extents;
-  if (const auto* k = std::get_if<collision::Capsule>(&shape)) {
-    c.radius = k->radius;
-    c.half_length = k->half_length;
-  }
-  c.inertia = system_.inertia()[i];
-  c.material = system_.materials()[i];
-  c.fixed = !system_.dynamic(i);
-  return c;
+void Simulation::add_body(BodyRecord record, const body::State& state) {
+  record.state = state;
+  system_.add(record);
+  created_.push_back(std::move(record));
 }
 
 void Simulation::generate_initial() {
@@ -457,7 +424,7 @@ void Simulation::generate_initial() {
         scratch_->owner.push_back(system_.ids()[i]);
       }
     }
-    auto place = [&](const BodyConstants& c, const body::State& x) {
+    auto place = [&](const BodyRecord& c, const body::State& x) {
       const Vector3 p = x.q.head<3>();
       const double r = bounding_radius(c);
       if (spheres) {
@@ -472,8 +439,8 @@ void Simulation::generate_initial() {
         scratch_->grid.insert(p, r);
         scratch_->owner.push_back(c.id);
       }
-      if (!c.fixed) {
-        const auto [gap, s] = static_gap(c, x);
+      if (c.dynamic()) {
+        const auto [gap, s] = static_gap(c.shape, x);
         if (gap < -1e-6 * r) {
           std::ostringstream out;
           out << "generator: the body at (" << p.x() << ", " << p.y() << ", " << p.z()
@@ -486,7 +453,7 @@ void Simulation::generate_initial() {
     };
     if (spec.kind == GeneratorKind::list) {
       for (const Vector3& p : spec.positions) {
-        const BodyConstants c = make_constants(g, random);
+        const BodyRecord c = make_body(g, random);
         place(c, state_at(p));
         ++next_id_;
         ++made;
@@ -525,7 +492,7 @@ void Simulation::generate_initial() {
       for (std::uint64_t k = 0; k < static_cast<std::uint64_t>(n); ++k) {
         const Vector3 site(static_cast<double>(k % nx), static_cast<double>((k / nx) % ny),
                            static_cast<double>(k / (nx * ny)));
-        BodyConstants c = make_constants(g, random);
+        BodyRecord c = make_body(g, random);
         const double r_i = bounding_radius(c);
         // A shift of at most s/2 − r_i per coordinate keeps neighbours apart and the body
         // inside the region.
@@ -543,11 +510,11 @@ void Simulation::generate_initial() {
              "generator.count: expected at most 10⁸ bodies, found " + std::to_string(spec.count));
       }
       require_memory(system_.size() + spec.count, g);
-      std::vector<BodyConstants> bodies;
+      std::vector<BodyRecord> bodies;
       bodies.reserve(spec.count);
       double volume = 0.0;
       for (std::uint64_t k = 0; k < spec.count; ++k) {
-        bodies.push_back(make_constants(g, random));
+        bodies.push_back(make_body(g, random));
         const double r = bounding_radius(bodies.back());
         volume += 4.0 / 3.0 * M_PI * r * r * r;
         ++next_id_;
@@ -564,7 +531,7 @@ void Simulation::generate_initial() {
       std::vector<std::size_t> order(bodies.size());
       for (std::size_t k = 0; k < order.size(); ++k) order[k] = k;
       std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
-        return bodies[a].radius > bodies[b].radius;
+        return radius_of(bodies[a]) > radius_of(bodies[b]);
       });
       double r_existing = 0.0;
       for (double r : system_.bounding_radii()) r_existing = std::max(r_existing, r);
@@ -574,7 +541,7 @@ void Simulation::generate_initial() {
       }
       std::vector<body::State> states(bodies.size());
       for (std::size_t k : order) {
-        const BodyConstants& c = bodies[k];
+        const BodyRecord& c = bodies[k];
         const double r = bounding_radius(c);
         const Vector3 room = extent - Vector3::Constant(2.0 * r);
         if ((room.array() < 0.0).any()) {
@@ -588,7 +555,7 @@ void Simulation::generate_initial() {
           for (int d = 0; d < 3; ++d) p[d] = spec.region.min[d] + r + room[d] * random.uniform();
           if (grid.overlaps(p, r)) continue;
           const body::State x = state_at(p);
-          if (!c.fixed && static_gap(c, x).first < 0.0) continue;  // inside static geometry
+          if (c.dynamic() && static_gap(c.shape, x).first < 0.0) continue;  // inside statics
           grid.insert(p, r);
           states[k] = x;
           placed = true;
@@ -655,7 +622,7 @@ void Simulation::inflow() {
       // The body's radius and its tries are drawn from the saved state, so a body that does not
       // fit now is drawn again, identically, at the next step.
       Random trial = random;
-      BodyConstants c = make_constants(g, trial);
+      BodyRecord c = make_body(g, trial);
       const double r = bounding_radius(c);
       const Vector3 room = (hi - lo) - Vector3::Constant(2.0 * r);
       if ((room.array() < 0.0).any()) {
@@ -670,7 +637,7 @@ void Simulation::inflow() {
         for (int d = 0; d < 3; ++d) p[d] = lo[d] + r + room[d] * trial.uniform();
         if (grid.overlaps(p, r)) continue;
         x = initial_state(group, trial, p);
-        placed = c.fixed || statics_.size() == 0 || static_gap(c, x).first >= 0.0;
+        placed = !c.dynamic() || statics_.size() == 0 || static_gap(c.shape, x).first >= 0.0;
       }
       if (!placed) {
         backlog_ += due - state.created;
@@ -717,9 +684,8 @@ SimulationState Simulation::save() const {
   s.next_id = next_id_;
   s.removed = removed_;
   s.removed_mass = removed_mass_;
-  s.bodies.reserve(system_.size());
-  for (std::size_t i = 0; i < system_.size(); ++i) s.bodies.push_back(constants(i));
-  s.states.assign(system_.states().begin(), system_.states().end());
+  s.bodies.reserve(system_.owned_count());
+  for (std::size_t i = 0; i < system_.owned_count(); ++i) s.bodies.push_back(system_.record(i));
   const timestep::WarmStartTable& warm = stepper_->warm_starts();
   s.warm_keys.assign(warm.keys().begin(), warm.keys().end());
   s.warm_lambda.assign(warm.lambda().begin(), warm.lambda().end());
@@ -733,9 +699,8 @@ void Simulation::restore(const SimulationState& state) {
     refuse("expected the state of a scene with " + std::to_string(scene_.groups.size()) +
            " body groups, found " + std::to_string(state.generators.size()));
   }
-  if (state.bodies.size() != state.states.size() ||
-      state.warm_keys.size() != state.warm_lambda.size()) {
-    refuse("the body or warm-start arrays differ in length");
+  if (state.warm_keys.size() != state.warm_lambda.size()) {
+    refuse("the warm-start arrays differ in length");
   }
   // The clock counts steps of this scene's Δt: t and steps must agree to half a step.
   const double dt = scene_.settings.dt;
@@ -760,7 +725,7 @@ void Simulation::restore(const SimulationState& state) {
   removed_mass_ = state.removed_mass;
   system_.reserve(state.bodies.size());
   for (std::size_t i = 0; i < state.bodies.size(); ++i) {
-    const BodyConstants& c = state.bodies[i];
+    const BodyRecord& c = state.bodies[i];
     if (c.material >= materials_.size()) {
       refuse("body " + std::to_string(c.id) + " has material " + std::to_string(c.material) +
              ", the scene has " + std::to_string(materials_.size()));
@@ -771,7 +736,7 @@ void Simulation::restore(const SimulationState& state) {
     }
     require_from_scene(c);
     try {
-      system_.add(spec_of(c, state.states[i]));
+      system_.add(c);
     } catch (const InvalidArgument& e) {
       refuse(e.what());
     }
@@ -781,18 +746,23 @@ void Simulation::restore(const SimulationState& state) {
 // A body of the state must be one that a group of the scene makes: its shape, material and
 // fixedness, a size the group's distribution can draw, and the mass and moments the group's
 // density or mass give it (to 10⁻¹² relative: a damaged or foreign value is refused).
-void Simulation::require_from_scene(const BodyConstants& c) const {
+void Simulation::require_from_scene(const BodyRecord& c) const {
   const auto close = [](double a, double b) {
     return std::abs(a - b) <= 1e-12 * std::max(std::abs(a), std::abs(b));
   };
+  const ShapeKind shape = collision::kind(c.shape);
+  const double radius = radius_of(c);
   for (const BodyGroup& g : scene_.groups) {
-    if (g.shape != c.shape || *materials_.find(g.material) != c.material || g.fixed != c.fixed)
+    if (g.shape != shape || *materials_.find(g.material) != c.material || g.fixed == c.dynamic())
       continue;
-    if (c.shape == ShapeKind::box ? g.half_extents != c.half_extents
-                                  : !(c.radius >= g.radius.min() && c.radius <= g.radius.max()))
+    const auto* box = std::get_if<collision::Box>(&c.shape);
+    if (box ? g.half_extents != box->half_extents
+            : !(radius >= g.radius.min() && radius <= g.radius.max()))
       continue;
-    if (c.shape == ShapeKind::capsule && g.half_length != c.half_length) continue;
-    const BodyConstants expected = constants_for(g, c.radius);
+    if (const auto* capsule = std::get_if<collision::Capsule>(&c.shape);
+        capsule != nullptr && g.half_length != capsule->half_length)
+      continue;
+    const BodyRecord expected = body_for(g, radius);
     if (close(expected.inertia.m, c.inertia.m) &&
         close(expected.inertia.K_Theta[0], c.inertia.K_Theta[0]) &&
         close(expected.inertia.K_Theta[1], c.inertia.K_Theta[1]) &&
@@ -801,8 +771,8 @@ void Simulation::require_from_scene(const BodyConstants& c) const {
     }
   }
   throw StateError("body " + std::to_string(c.id) + " (a " +
-                   std::string(collision::kind_name(c.shape)) + " of radius " +
-                   format_number(c.radius) + " m, mass " + format_number(c.inertia.m) +
+                   std::string(collision::kind_name(shape)) + " of radius " +
+                   format_number(radius) + " m, mass " + format_number(c.inertia.m) +
                    " kg, moments (" + format_number(c.inertia.K_Theta[0]) + ", " +
                    format_number(c.inertia.K_Theta[1]) + ", " +
                    format_number(c.inertia.K_Theta[2]) + ") kg m²) is not a body that a group "

@@ -19,14 +19,14 @@ namespace grbd::timestep {
 
 namespace {
 
-/// New index i takes the element at old index order[i], in place, along the cycles of the
-/// permutation: swapping v[j] with v[order[j]] puts the right element at j and carries the
-/// cycle's first element on, until the cycle closes. `done` has one flag per element.
+/// New index i takes the element at old index order[i], for i < order.size(), in place, along the
+/// cycles of the permutation: swapping v[j] with v[order[j]] puts the right element at j and
+/// carries the cycle's first element on, until the cycle closes. `done` has one flag per index.
 template <class T>
 void permute_in_place(std::vector<T>& v, std::span<const std::int32_t> order,
                       std::vector<std::uint8_t>& done) {
   std::fill(done.begin(), done.end(), std::uint8_t{0});
-  for (std::size_t i = 0; i < v.size(); ++i) {
+  for (std::size_t i = 0; i < order.size(); ++i) {
     if (done[i]) continue;
     std::size_t j = i;
     done[j] = 1;
@@ -41,6 +41,11 @@ void permute_in_place(std::vector<T>& v, std::span<const std::int32_t> order,
 
 std::string body_name(GlobalId id) { return "body " + std::to_string(id); }
 
+/// The hash of a ghost's identity (global id, image).
+std::uint64_t ghost_hash(GlobalId id, std::uint32_t image) {
+  return mix64(mix64(id) ^ (std::uint64_t{image} * 0x9e3779b97f4a7c15ULL));
+}
+
 }  // namespace
 
 void BodySystem::reserve(std::size_t bodies) {
@@ -52,53 +57,165 @@ void BodySystem::reserve(std::size_t bodies) {
   materials_.reserve(bodies);
   flags_.reserve(bodies);
   bounding_radii_.reserve(bodies);
+  images_.reserve(bodies);
 }
 
-std::size_t BodySystem::add(const BodySpec& spec) {
-  const std::string where = "BodySystem::add (" + body_name(spec.id) + ")";
+// Everything add() and add_ghost() refuse; the message (and its allocation) only on failure.
+void BodySystem::validate(const BodyRecord& spec, const char* what, std::uint32_t image) const {
+  const auto where = [&] { return std::string(what) + " (" + body_name(spec.id) + ")"; };
   if (spec.id >= kStaticTag) {
-    throw InvalidArgument(where + ": expected a global id below 2^63, found " +
+    throw InvalidArgument(where() + ": expected a global id below 2^63, found " +
                           std::to_string(spec.id));
   }
-  if (index_of(spec.id) != npos) {
-    throw InvalidArgument(where + ": the global id " + std::to_string(spec.id) +
-                          " is already used by the body at local index " +
+  if ((spec.flags & ~kDynamic) != 0) {
+    throw InvalidArgument(where() + ": expected the flags kDynamic or none, found " +
+                          std::to_string(spec.flags) + " (kOwned belongs to the row)");
+  }
+  if (image == 0 && index_of(spec.id) != npos) {
+    throw InvalidArgument(where() + ": the global id " + std::to_string(spec.id) +
+                          " is already used by the owned body at local index " +
                           std::to_string(index_of(spec.id)));
   }
   if (size() >= std::numeric_limits<std::int32_t>::max() - 1) {
-    throw InvalidArgument(where + ": a system holds at most 2^31 - 2 bodies");
+    throw InvalidArgument(where() + ": a system holds at most 2^31 - 2 bodies");
   }
-  body::require_valid(spec.state, where);
-  body::require_valid(spec.inertia, where);
-  collision::Shape shape = spec.shape;
-  const collision::ShapeKind kind = collision::kind(shape);
+  const collision::ShapeKind kind = collision::kind(spec.shape);
   if (kind != collision::ShapeKind::sphere && kind != collision::ShapeKind::box &&
       kind != collision::ShapeKind::capsule) {
-    throw InvalidArgument(where + ": expected a sphere, a box or a capsule as the shape of a body, "
-                          "found a " + std::string(collision::kind_name(kind)) +
+    throw InvalidArgument(where() + ": expected a sphere, a box or a capsule as the shape of a "
+                          "body, found a " + std::string(collision::kind_name(kind)) +
                           " (half-spaces and meshes are static objects)");
   }
-  collision::normalize_and_check(shape, where);
+  try {
+    // The checks get the literal `what`; the body's name goes in only when one of them fails.
+    body::require_valid(spec.state, what);
+    body::require_valid(spec.inertia, what);
+    collision::Shape shape = spec.shape;  // a sphere, box or capsule: copied without allocating
+    collision::normalize_and_check(shape, what);
+  } catch (const InvalidArgument& e) {
+    throw InvalidArgument(where() + std::string(e.what()).substr(std::string_view(what).size()));
+  }
+}
 
-  const std::size_t index = size();
-  ids_.push_back(spec.id);
-  states_.push_back(spec.state);
-  inertia_.push_back(spec.inertia);
-  M_inv_.push_back(spec.dynamic ? contact::inverse_mass(spec.inertia)
-                                : contact::InverseMass{0.0, Vector3::Zero()});
-  bounding_radii_.push_back(collision::bounding_radius(shape));
-  shapes_.push_back(std::move(shape));
-  materials_.push_back(spec.material);
-  flags_.push_back(static_cast<std::uint8_t>((spec.dynamic ? kDynamic : 0) | kOwned));
-  if (!spec.dynamic) states_.back().u.setZero();
+// Writes the row of a valid body (its shape is a sphere, box or capsule, so it is normalized).
+void BodySystem::set_row(std::size_t i, const BodyRecord& spec, const Vector3& shift,
+                         std::uint32_t image, bool owned) {
+  ids_[i] = spec.id;
+  states_[i] = spec.state;
+  states_[i].q.head<3>() += shift;
+  if (!spec.dynamic()) states_[i].u.setZero();
+  inertia_[i] = spec.inertia;
+  M_inv_[i] = spec.dynamic() ? contact::inverse_mass(spec.inertia)
+                           : contact::InverseMass{0.0, Vector3::Zero()};
+  bounding_radii_[i] = collision::bounding_radius(spec.shape);
+  shapes_[i] = spec.shape;
+  materials_[i] = spec.material;
+  flags_[i] = static_cast<std::uint8_t>((spec.dynamic() ? kDynamic : 0) | (owned ? kOwned : 0));
+  images_[i] = image;
+}
+
+void BodySystem::resize_rows(std::size_t n) {
+  ids_.resize(n);
+  states_.resize(n);
+  inertia_.resize(n);
+  M_inv_.resize(n);
+  shapes_.resize(n);
+  materials_.resize(n);
+  flags_.resize(n);
+  bounding_radii_.resize(n);
+  images_.resize(n);
+}
+
+void BodySystem::move_row(std::size_t from, std::size_t to) {
+  ids_[to] = ids_[from];
+  states_[to] = states_[from];
+  inertia_[to] = inertia_[from];
+  M_inv_[to] = M_inv_[from];
+  shapes_[to] = shapes_[from];
+  materials_[to] = materials_[from];
+  flags_[to] = flags_[from];
+  bounding_radii_[to] = bounding_radii_[from];
+  images_[to] = images_[from];
+}
+
+BodyRecord BodySystem::record(std::size_t i) const {
+  BodyRecord spec;
+  spec.id = ids_[i];
+  spec.state = states_[i];
+  spec.inertia = inertia_[i];
+  spec.shape = shapes_[i];
+  spec.material = materials_[i];
+  spec.flags = flags_[i] & kDynamic;
+  return spec;
+}
+
+// [add owned]
+std::size_t BodySystem::add(const BodyRecord& spec) {
+  validate(spec, "BodySystem::add", 0);
+  if (ghost_count() > 0 && ghost_index_of(spec.id, 0) != npos) {
+    throw InvalidArgument("BodySystem::add (" + body_name(spec.id) + "): a ghost of it is present "
+                          "at local index " + std::to_string(ghost_index_of(spec.id, 0)) +
+                          "; clear the ghosts before a body becomes owned here");
+  }
+  const std::size_t index = owned_count_;
+  const std::size_t last = size();
+  resize_rows(last + 1);
+  if (last > index) {
+    // Ghosts follow the owned bodies: the first ghost moves to the new last row, in O(1).
+    const std::size_t slot = ghost_slot(ids_[index], images_[index]);
+    move_row(index, last);
+    ghost_slots_[slot] = static_cast<std::uint32_t>(last + 1);
+  }
+  set_row(index, spec, Vector3::Zero(), 0, true);
+  ++owned_count_;
   ++layout_version_;
   // Grow the table at a load factor of 1/2; otherwise insert in O(1).
-  if (2 * size() > slots_.size()) {
+  if (2 * owned_count_ > slots_.size()) {
     rebuild_index();
   } else {
     insert_index(spec.id, index);
   }
   return index;
+}
+// [add owned]
+
+std::size_t BodySystem::add_ghost(const BodyRecord& spec, const Vector3& shift,
+                                  std::uint32_t image) {
+  validate(spec, "BodySystem::add_ghost", image);
+  if (!shift.allFinite()) {
+    throw InvalidArgument("BodySystem::add_ghost (" + body_name(spec.id) +
+                          "): expected a finite shift");
+  }
+  if (ghost_index_of(spec.id, image) != npos) {
+    throw InvalidArgument("BodySystem::add_ghost (" + body_name(spec.id) + "): its ghost with "
+                          "image " + std::to_string(image) + " is present already at local index " +
+                          std::to_string(ghost_index_of(spec.id, image)));
+  }
+  const std::size_t index = size();
+  resize_rows(index + 1);
+  set_row(index, spec, shift, image, false);
+  ++layout_version_;
+  if (2 * ghost_count() > ghost_slots_.size()) {
+    rebuild_ghost_index();
+  } else {
+    insert_ghost_index(index);
+  }
+  return index;
+}
+
+void BodySystem::clear_ghosts() {
+  if (ghost_count() == 0) return;
+  // Every entry goes, so each ghost's probe run from its home slot is emptied up to the first
+  // empty slot: whatever a run skips was emptied by an earlier run. O(ghosts).
+  const std::size_t mask = ghost_slots_.size() - 1;
+  for (std::size_t i = owned_count_; i < size(); ++i) {
+    for (std::size_t slot = ghost_hash(ids_[i], images_[i]) & mask; ghost_slots_[slot] != 0;
+         slot = (slot + 1) & mask) {
+      ghost_slots_[slot] = 0;
+    }
+  }
+  resize_rows(owned_count_);
+  ++layout_version_;
 }
 
 void BodySystem::insert_index(GlobalId id, std::size_t index) {
@@ -109,10 +226,24 @@ void BodySystem::insert_index(GlobalId id, std::size_t index) {
 }
 
 void BodySystem::rebuild_index() {
-  const std::size_t wanted = std::bit_ceil(std::max<std::size_t>(16, 2 * size()));
+  const std::size_t wanted = std::bit_ceil(std::max<std::size_t>(16, 2 * owned_count_));
   if (slots_.size() < wanted) slots_.resize(wanted);
   std::fill(slots_.begin(), slots_.end(), 0U);
-  for (std::size_t i = 0; i < size(); ++i) insert_index(ids_[i], i);
+  for (std::size_t i = 0; i < owned_count_; ++i) insert_index(ids_[i], i);
+}
+
+void BodySystem::insert_ghost_index(std::size_t index) {
+  const std::size_t mask = ghost_slots_.size() - 1;
+  std::size_t slot = ghost_hash(ids_[index], images_[index]) & mask;
+  while (ghost_slots_[slot] != 0) slot = (slot + 1) & mask;
+  ghost_slots_[slot] = static_cast<std::uint32_t>(index + 1);
+}
+
+void BodySystem::rebuild_ghost_index() {
+  const std::size_t wanted = std::bit_ceil(std::max<std::size_t>(16, 2 * ghost_count()));
+  if (ghost_slots_.size() < wanted) ghost_slots_.resize(wanted);
+  std::fill(ghost_slots_.begin(), ghost_slots_.end(), 0U);
+  for (std::size_t i = owned_count_; i < size(); ++i) insert_ghost_index(i);
 }
 
 std::size_t BodySystem::index_of(GlobalId id) const {
@@ -125,12 +256,27 @@ std::size_t BodySystem::index_of(GlobalId id) const {
   }
 }
 
+std::size_t BodySystem::ghost_slot(GlobalId id, std::uint32_t image) const {
+  if (ghost_slots_.empty()) return npos;
+  const std::size_t mask = ghost_slots_.size() - 1;
+  for (std::size_t slot = ghost_hash(id, image) & mask;; slot = (slot + 1) & mask) {
+    const std::uint32_t entry = ghost_slots_[slot];
+    if (entry == 0) return npos;
+    if (ids_[entry - 1] == id && images_[entry - 1] == image) return slot;
+  }
+}
+
+std::size_t BodySystem::ghost_index_of(GlobalId id, std::uint32_t image) const {
+  const std::size_t slot = ghost_slot(id, image);
+  return slot == npos ? npos : ghost_slots_[slot] - 1;
+}
+
 void BodySystem::remove(std::span<const std::size_t> indices) {
   done_.assign(size(), 0);
   for (const std::size_t i : indices) {
-    if (i >= size()) {
-      throw InvalidArgument("BodySystem::remove: expected local indices below " +
-                            std::to_string(size()) + ", found " + std::to_string(i));
+    if (i >= owned_count_) {
+      throw InvalidArgument("BodySystem::remove: expected local indices of owned bodies, below " +
+                            std::to_string(owned_count_) + ", found " + std::to_string(i));
     }
     if (done_[i]) {
       throw InvalidArgument("BodySystem::remove: local index " + std::to_string(i) +
@@ -157,15 +303,19 @@ void BodySystem::remove(std::span<const std::size_t> indices) {
   compact(materials_);
   compact(flags_);
   compact(bounding_radii_);
+  compact(images_);
+  owned_count_ -= indices.size();
   ++layout_version_;
   rebuild_index();
+  if (ghost_count() > 0) rebuild_ghost_index();
 }
 
 void BodySystem::permute(std::span<const std::int32_t> order) {
-  const std::size_t n = size();
+  const std::size_t n = owned_count_;
   if (order.size() != n) {
-    throw InvalidArgument("BodySystem::permute: expected a permutation of " + std::to_string(n) +
-                          " indices, found " + std::to_string(order.size()) + " entries");
+    throw InvalidArgument("BodySystem::permute: expected a permutation of the " +
+                          std::to_string(n) + " owned bodies, found " +
+                          std::to_string(order.size()) + " entries");
   }
   done_.assign(n, 0);
   for (std::size_t i = 0; i < n; ++i) {
@@ -193,7 +343,7 @@ void BodySystem::permute(std::span<const std::int32_t> order) {
 
 // [reorder morton]
 void BodySystem::reorder_morton(double cell_size) {
-  const std::size_t n = size();
+  const std::size_t n = owned_count_;
   positions_.resize(n);
   for (std::size_t i = 0; i < n; ++i) positions_[i] = states_[i].q.head<3>();
   codes_.resize(n);

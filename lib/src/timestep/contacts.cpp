@@ -181,6 +181,7 @@ void ContactDetector::detect(const BodySystem& system, const StaticGeometry& sta
       const auto a = static_cast<std::size_t>(sphere_bodies_[static_cast<std::size_t>(i)]);
       const auto b = static_cast<std::size_t>(sphere_bodies_[static_cast<std::size_t>(j)]);
       if (!system.dynamic(a) && !system.dynamic(b)) continue;
+      if (!system.owned(a) && !system.owned(b)) continue;  // two ghosts: another process's pair
       pair({true, a}, {true, b});
     }
   }
@@ -191,6 +192,7 @@ void ContactDetector::detect(const BodySystem& system, const StaticGeometry& sta
     for (std::size_t j = 0; j < n; ++j) {
       if (j == i || (j < i && !std::holds_alternative<collision::Sphere>(shapes[j]))) continue;
       if (!system.dynamic(i) && !system.dynamic(j)) continue;
+      if (!system.owned(i) && !system.owned(j)) continue;
       const double reach = radii[i] + radii[j] + margin;
       if ((placements_[i].I_r - placements_[j].I_r).squaredNorm() <= reach * reach) {
         pair({true, i}, {true, j});
@@ -206,7 +208,7 @@ void ContactDetector::detect(const BodySystem& system, const StaticGeometry& sta
     const double r_s = bounded ? collision::bounding_radius(objects[s].shape) : 0.0;
     const auto* half_space = std::get_if<collision::HalfSpace>(&objects[s].shape);
     for (std::size_t i = 0; i < n; ++i) {
-      if (!system.dynamic(i)) continue;
+      if (!system.dynamic(i) || !system.owned(i)) continue;
       // A half-space (frame I) is skipped by the height of the bounding sphere above it: most
       // bodies of a pile are far from most walls, and the test costs one dot product.
       if (half_space != nullptr &&

@@ -207,8 +207,9 @@ Vector7 MoreauStepper::half(const Vector7& q, const Vector6& u) const {
 bool MoreauStepper::reorder_if_due() {
   check_layout();
   const auto interval = static_cast<std::uint64_t>(settings_.reorder_interval);
-  if (interval == 0 || steps_ == 0 || steps_ % interval != 0 || system_.size() == 0) return false;
-  const auto radii = system_.bounding_radii();
+  const std::size_t owned = system_.owned_count();
+  if (interval == 0 || steps_ == 0 || steps_ % interval != 0 || owned == 0) return false;
+  const auto radii = system_.bounding_radii().first(owned);
   system_.reorder_morton(2.0 * *std::max_element(radii.begin(), radii.end()));
   checked_layout_ = system_.layout_version();  // the same bodies, reordered
   return true;
@@ -217,6 +218,7 @@ bool MoreauStepper::reorder_if_due() {
 // [stage midpoint]
 // 1. The midpoint q_M = q_S + Δt/2 F(q_S) u_S, the loads there, and the problem's world-frame
 // inverse masses, u_free = u_S + Δt M⁻¹ h and u_S (in solution_.u until the solver overwrites it).
+// Ghosts too: they hold their owner's q_S and u_S, and the same arithmetic gives the owner's q_M.
 void MoreauStepper::midpoint(const StepReport& report) {
   const double dt = settings_.dt;
   const std::size_t n = system_.size();
@@ -385,7 +387,7 @@ void MoreauStepper::solve(StepReport& report) {
 // 5. u_E back in the body frames, q_E = q_M + Δt/2 F(q_M) u_E, the warm starts kept, the
 // energies and the checks for a blow-up; the clock advances.
 void MoreauStepper::finish(StepReport& report) {
-  const std::size_t n = system_.size();
+  const std::size_t n = system_.owned_count();  // ghosts stay at q_M: their owners advance them
   const auto states = system_.states();
   const auto inertia = system_.inertia();
   for (std::size_t i = 0; i < n; ++i) {
@@ -438,7 +440,7 @@ void MoreauStepper::require_finite(const StepReport& report, const char* where) 
                                " J, potential energy " + format_number(report.potential_energy) +
                                " J";
   const auto radii = system_.bounding_radii();
-  for (std::size_t i = 0; i < system_.size(); ++i) {
+  for (std::size_t i = 0; i < system_.owned_count(); ++i) {
     const body::State& x = states[i];
     const double e = body::kinetic_energy(inertia[i], x.u) -
                      inertia[i].m * settings_.I_g.dot(x.q.head<3>());
@@ -488,7 +490,7 @@ void MoreauStepper::correct_drift() {
     }
   }
   const auto states = system_.states();
-  for (std::size_t i = 0; i < n; ++i) states[i].q.head<3>() += shift_[i];
+  for (std::size_t i = 0; i < system_.owned_count(); ++i) states[i].q.head<3>() += shift_[i];
 }
 // [drift correction]
 

@@ -20,7 +20,7 @@ int main() {
   const body::MassProperties mp = body::sphere_mass_properties(r, 2500.0);
   const double heights[2] = {r, 1.0};  // on the floor; a metre above it
   for (int i = 0; i < 2; ++i) {
-    timestep::BodySpec sphere;
+    timestep::BodyRecord sphere;
     sphere.id = static_cast<timestep::GlobalId>(i);
     sphere.state.q << 0.1 * i, 0.0, heights[i], 1.0, 0.0, 0.0, 0.0;
     sphere.state.u.setZero();

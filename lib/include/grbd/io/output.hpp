@@ -59,7 +59,7 @@ inline constexpr std::uint64_t kOutputFormatVersion = 1;
 /// What identifies the run a restart continues: the output it reopens must be that run's.
 struct RunIdentity {
   std::string scene_text;                        ///< the scene the run was started from
-  std::span<const scene::BodyConstants> bodies;  ///< the bodies at the checkpoint
+  std::span<const timestep::BodyRecord> bodies;  ///< the bodies at the checkpoint
 };
 
 /// The static geometry of a scene as one surface of triangles in frame I, which the output keeps

@@ -18,22 +18,6 @@
 
 namespace grbd::scene {
 
-/// What never changes about a body: its identity, shape, inertia and material. With its state it
-/// is the body; the output writes one row of these per body created, a checkpoint one per body.
-struct BodyConstants {
-  timestep::GlobalId id = 0;                                  ///< stable global id
-  collision::ShapeKind shape = collision::ShapeKind::sphere;  ///< sphere, box or capsule
-  double radius = 0.0;                     ///< sphere, capsule: radius [m]; box: 0
-  Vector3 half_extents = Vector3::Zero();  ///< box [m]; else 0
-  double half_length = 0.0;                ///< capsule [m]; else 0
-  body::RigidBody inertia;                 ///< m, K_Theta
-  timestep::MaterialId material = 0;       ///< row of the material table
-  bool fixed = false;                      ///< never moves
-};
-
-/// The collision shape of a body.
-collision::Shape shape_of(const BodyConstants& body);
-
 /// What a generator has done so far: enough to continue it exactly.
 struct GeneratorState {
   std::uint64_t random = 0;   ///< state of its Random
@@ -47,8 +31,7 @@ struct SimulationState {
   std::uint64_t next_id = 0;                    ///< the global id of the next body created
   std::uint64_t removed = 0;                    ///< bodies removed by the outlet so far
   double removed_mass = 0.0;                    ///< their mass [kg]
-  std::vector<BodyConstants> bodies;            ///< in the system's order
-  std::vector<body::State> states;              ///< their states
+  std::vector<timestep::BodyRecord> bodies;     ///< with their states, in the system's order
   std::vector<timestep::ContactKey> warm_keys;  ///< the stepper's warm starts
   std::vector<Vector3> warm_lambda;             ///< their percussions
   std::vector<GeneratorState> generators;       ///< one per body group
@@ -102,10 +85,9 @@ class Simulation {
   timestep::MoreauStepper& stepper() { return *stepper_; }                 ///< the stepper
   const timestep::MoreauStepper& stepper() const { return *stepper_; }     ///< the stepper
   ///@}
-  /// The constants of the body with local index i (from the system's arrays).
-  BodyConstants constants(std::size_t i) const;
-  /// Bodies created since the caller last emptied this list (their constants), for the output.
-  std::vector<BodyConstants>& created() { return created_; }
+  /// Bodies created since the caller last emptied this list (their records, in the state they
+  /// were created with), for the output.
+  std::vector<timestep::BodyRecord>& created() { return created_; }
   /// Bodies created so far (all groups) and removed by the outlet.
   std::uint64_t bodies_created() const { return next_id_; }
   std::uint64_t bodies_removed() const { return removed_; }  ///< by the outlet
@@ -119,18 +101,18 @@ class Simulation {
   void restore(const SimulationState& state);
   void build_static();
   void generate_initial();
-  void add_body(const BodyConstants& constants, const body::State& state);
+  void add_body(timestep::BodyRecord record, const body::State& state);
   void inflow();
   void outlet();
   void check_shapes() const;
-  BodyConstants make_constants(std::size_t group, Random& random);
-  BodyConstants constants_for(const BodyGroup& group, double radius) const;
+  timestep::BodyRecord make_body(std::size_t group, Random& random);
+  timestep::BodyRecord body_for(const BodyGroup& group, double radius) const;
   void require_invertible_constants() const;
   void require_memory(std::uint64_t bodies, std::size_t group) const;
-  void require_from_scene(const BodyConstants& body) const;
+  void require_from_scene(const timestep::BodyRecord& body) const;
   // The deepest overlap of a body (its constants and a state) with the static geometry: the gap
   // (< 0 when they overlap, +∞ without static objects) and the static object's index.
-  std::pair<double, std::size_t> static_gap(const BodyConstants& c, const body::State& x);
+  std::pair<double, std::size_t> static_gap(const collision::Shape& shape, const body::State& x);
   struct Scratch;
 
   const Scene scene_;
@@ -138,7 +120,7 @@ class Simulation {
   timestep::StaticGeometry statics_;
   timestep::BodySystem system_;
   std::optional<timestep::MoreauStepper> stepper_;
-  std::vector<BodyConstants> created_;
+  std::vector<timestep::BodyRecord> created_;
   std::vector<GeneratorState> generators_;
   std::uint64_t next_id_ = 0;
   std::uint64_t removed_ = 0;

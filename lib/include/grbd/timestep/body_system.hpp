@@ -2,8 +2,10 @@
 /// \file
 /// \brief The system of bodies (chapter 6): one owner of every per-body array, indexed by a local
 /// body index and moved together by append, remove and permute; every body carries a stable
-/// 64-bit global id. The static geometry (walls, floors, obstacles) is kept apart, each object
-/// with its own stable id. Chapters 7 (scene files, restart) and 8 (MPI migration) build on both.
+/// 64-bit global id. The bodies a process owns come first, ghost copies of other processes' bodies
+/// (or shifted periodic images) after them. The static geometry (walls, floors, obstacles) is
+/// kept apart, each object with its own stable id. Chapters 7 (scene files, restart) and 8 (MPI
+/// migration, ghosts) build on both.
 
 #include <cstddef>
 #include <cstdint>
@@ -17,35 +19,9 @@
 #include "grbd/collision/shapes.hpp"
 #include "grbd/contact/problem.hpp"
 #include "grbd/core/types.hpp"
+#include "grbd/timestep/body_record.hpp"
 
 namespace grbd::timestep {
-
-/// The stable identity of a body (or of a static object): never reused within a run, kept by
-/// reordering, removal, restart and, in chapter 8, migration between MPI ranks.
-using GlobalId = std::uint64_t;
-/// The index of a material in a MaterialTable.
-using MaterialId = std::uint32_t;
-
-/// Global ids of static objects are tagged with this bit in contact keys, so that a body and a
-/// static object never share an identity. Body ids must stay below it.
-inline constexpr GlobalId kStaticTag = GlobalId{1} << 63;
-
-/// Flags of a body, one byte per body.
-enum BodyFlags : std::uint8_t {
-  kDynamic = 1U << 0,  ///< moves under forces and contacts; without it the body is fixed (u = 0)
-  kOwned = 1U << 1,    ///< integrated by this process (chapter 8: remote copies lack it)
-};
-
-/// Everything that describes one body when it enters the system.
-struct BodySpec {
-  GlobalId id = 0;                ///< stable identity, unique in the system, < kStaticTag
-  body::State state;              ///< q = (I_r_S, p) with |p| = 1, u = (I_v_S, K_omega)
-  body::RigidBody inertia;        ///< mass and principal moments (frame K is principal)
-  /// The collision shape, centred at S with its axes along K: a sphere, a box or a capsule.
-  collision::Shape shape = collision::Sphere{};
-  MaterialId material = 0;        ///< row of the material table
-  bool dynamic = true;            ///< false: the body is fixed where it is (infinite mass)
-};
 
 /// The bodies of a simulation as parallel arrays ("structure of arrays"): entry i of every array
 /// belongs to the body with local index i. Local indices change when bodies are removed or
@@ -54,31 +30,58 @@ struct BodySpec {
 /// The arrays a time step reads and writes (states, inverse masses) are contiguous, so that the
 /// step streams through them; the system is reordered along a Morton curve every few steps
 /// (reorder_morton) so that bodies close in space are close in memory.
+///
+/// **Owned bodies and ghosts.** Rows [0, owned_count()) hold the bodies this process owns: it
+/// integrates them, writes them and reports their energy. Rows [owned_count(), size()) hold
+/// ghosts: copies of bodies that another process owns, or images of any body shifted by a
+/// periodic boundary, present so that contacts with owned bodies are found and solved here. A
+/// ghost has its own lookup by (global id, image), so a body and its shifted image can both be
+/// present; index_of() finds owned bodies only. Without ghosts (a serial run) every row is owned.
 class BodySystem {
  public:
-  /// Appends a body and returns its local index. Throws InvalidArgument, naming the body's id,
-  /// for an id already present or ≥ kStaticTag, an invalid state (body::require_valid) or
-  /// inertia, and a shape that is not a valid sphere, box or capsule. O(1) amortised.
-  std::size_t add(const BodySpec& spec);
-  /// Reserves room for `bodies` bodies in every array.
+  /// Appends an owned body and returns its local index, owned_count() − 1. Throws
+  /// InvalidArgument, naming the body's id, for an id already owned or ≥ kStaticTag, an invalid
+  /// state (body::require_valid) or inertia, and a shape that is not a valid sphere, box or
+  /// capsule. O(1) amortised (with ghosts present, the first ghost moves to the end to make
+  /// room); allocates nothing when the arrays have room.
+  std::size_t add(const BodyRecord& spec);
+  /// Appends a ghost: a copy of a body owned elsewhere, or (image ≠ 0) a periodic image of any
+  /// body, its position moved by `shift` [m]; returns its local index, size() − 1. The pair
+  /// (id, image) must be new among the ghosts, and a ghost with image 0 must not be owned here
+  /// (else InvalidArgument); otherwise checked as add(). O(1) amortised.
+  std::size_t add_ghost(const BodyRecord& spec, const Vector3& shift = Vector3::Zero(),
+                        std::uint32_t image = 0);
+  /// Removes every ghost, in O(ghosts); the owned bodies keep their rows.
+  void clear_ghosts();
+  /// Reserves room for `bodies` bodies (owned and ghosts) in every array.
   void reserve(std::size_t bodies);
-  /// Removes the bodies with the given local indices (any order, no duplicates, each < size(),
-  /// else InvalidArgument); the others keep their relative order. O(N).
+  /// Removes the owned bodies with the given local indices (any order, no duplicates, each
+  /// < owned_count(), else InvalidArgument); the others keep their relative order, ghosts
+  /// included. O(N).
   void remove(std::span<const std::size_t> indices);
-  /// Reorders the bodies: the body at new index i is the one at old index order[i]. `order` must
-  /// be a permutation of 0 … size() − 1 (else InvalidArgument). O(N), in place: it allocates
-  /// nothing once the system has seen one permutation of its size.
+  /// Reorders the owned bodies: the body at new index i is the one at old index order[i].
+  /// `order` must be a permutation of 0 … owned_count() − 1 (else InvalidArgument); ghosts keep
+  /// their rows. O(N), in place: it allocates nothing once the system has seen one permutation of
+  /// its size.
   void permute(std::span<const std::int32_t> order);
-  /// Reorders the bodies along the Morton (Z-order) curve of their centres on cells of edge
+  /// Reorders the owned bodies along the Morton (Z-order) curve of their centres on cells of edge
   /// `cell_size`, ties broken by global id: the same positions give the same order whatever the
   /// current order (collision::morton_codes(), whose InvalidArgument it passes on). O(N log N);
   /// allocates nothing once it has run at this size.
   void reorder_morton(double cell_size);
 
-  /// Number of bodies.
+  /// Number of rows: owned bodies and ghosts.
   std::size_t size() const { return ids_.size(); }
-  /// The local index of the body with global id `id`, or npos. O(1) expected.
+  /// Number of owned bodies: rows [0, owned_count()).
+  std::size_t owned_count() const { return owned_count_; }
+  /// Number of ghosts: rows [owned_count(), size()).
+  std::size_t ghost_count() const { return size() - owned_count_; }
+  /// True when row i holds an owned body.
+  bool owned(std::size_t i) const { return i < owned_count_; }
+  /// The local index of the owned body with global id `id`, or npos. O(1) expected.
   std::size_t index_of(GlobalId id) const;
+  /// The local index of the ghost of body `id` with image `image`, or npos. O(1) expected.
+  std::size_t ghost_index_of(GlobalId id, std::uint32_t image = 0) const;
   /// "No such body".
   static constexpr std::size_t npos = static_cast<std::size_t>(-1);
 
@@ -98,7 +101,13 @@ class BodySystem {
   std::span<const std::uint8_t> flags() const { return flags_; }  ///< BodyFlags bits
   /// Radius of the bounding sphere of each body's shape about S [m].
   std::span<const double> bounding_radii() const { return bounding_radii_; }
+  /// The image of each row: 0 for owned bodies and plain ghosts, the periodic image of a shifted
+  /// ghost as add_ghost() was given it.
+  std::span<const std::uint32_t> images() const { return images_; }
   ///@}
+  /// The record of the body in row i, as add() or add_ghost() would take it (a ghost's position
+  /// includes its shift).
+  BodyRecord record(std::size_t i) const;
   /// True when body i is dynamic.
   bool dynamic(std::size_t i) const { return (flags_[i] & kDynamic) != 0; }
   /// Increases whenever bodies are added, removed or reordered (what depends on local indices,
@@ -106,8 +115,16 @@ class BodySystem {
   std::uint64_t layout_version() const { return layout_version_; }
 
  private:
+  void validate(const BodyRecord& spec, const char* what, std::uint32_t image) const;
+  void set_row(std::size_t i, const BodyRecord& spec, const Vector3& shift, std::uint32_t image,
+               bool owned);
+  void resize_rows(std::size_t n);
+  void move_row(std::size_t from, std::size_t to);
   void rebuild_index();
+  void rebuild_ghost_index();
   void insert_index(GlobalId id, std::size_t index);
+  void insert_ghost_index(std::size_t index);
+  std::size_t ghost_slot(GlobalId id, std::uint32_t image) const;  // the slot, or npos
 
   std::vector<GlobalId> ids_;
   std::vector<body::State> states_;
@@ -117,9 +134,13 @@ class BodySystem {
   std::vector<MaterialId> materials_;
   std::vector<std::uint8_t> flags_;
   std::vector<double> bounding_radii_;
+  std::vector<std::uint32_t> images_;
+  std::size_t owned_count_ = 0;
   std::uint64_t layout_version_ = 0;
-  // Open addressing with linear probing, global id → local index + 1 (0: empty slot).
+  // Open addressing with linear probing, global id → local index + 1 (0: empty slot), for the
+  // owned bodies; and (global id, image) → local index + 1 for the ghosts.
   std::vector<std::uint32_t> slots_;
+  std::vector<std::uint32_t> ghost_slots_;
   // Scratch of permute() and reorder_morton(), kept to avoid allocation.
   std::vector<std::uint8_t> done_;
   std::vector<Vector3> positions_;

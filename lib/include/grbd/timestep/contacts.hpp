@@ -49,7 +49,9 @@ struct DetectedContact {
 ///
 /// Pairs of spheres go through the CellGrid of chapter 4; boxes and capsules meet the other
 /// bodies whose bounding spheres they touch; every dynamic body meets every static object.
-/// Fixed bodies meet dynamic ones only. The contacts come out in a canonical order: along the
+/// Fixed bodies meet dynamic ones only. With ghosts in the system (BodySystem), a pair needs an
+/// owned side: two ghosts, or a ghost and a static object, are another process's pair. The
+/// contacts come out in a canonical order: along the
 /// Morton curve of their points, ties broken by key, so that the order, and everything the
 /// solver computes from it, does not depend on how the bodies are stored.
 class ContactDetector {

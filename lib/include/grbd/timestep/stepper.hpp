@@ -89,8 +89,8 @@ struct StepReport {
   int iterations = 0;             ///< solver iterations
   double residual = 0.0;          ///< natural-map residual of the returned percussions
   bool converged = true;          ///< the solver met its tolerance (true without contacts)
-  double kinetic_energy = 0.0;    ///< at the end of the step [J]
-  double potential_energy = 0.0;  ///< −Σ m I_gᵀ I_r_S at the end of the step [J]
+  double kinetic_energy = 0.0;    ///< of the owned bodies at the end of the step [J]
+  double potential_energy = 0.0;  ///< −Σ m I_gᵀ I_r_S over the owned bodies, end of step [J]
   double max_penetration = 0.0;   ///< max(0, −g_N) over the contacts at the midpoint [m]
   StepTimes seconds;              ///< stage timings
 };
@@ -134,6 +134,12 @@ struct StepHooks {
 ///
 /// A step runs five named stages — midpoint(), detect(), assemble(), solve(), finish() — with the
 /// hooks of StepHooks between them (see step()).
+///
+/// Owned bodies and ghosts (BodySystem): the midpoint moves every dynamic row, ghosts included —
+/// a ghost holds its owner's q_S and u_S, so the same arithmetic gives the owner's q_M bit for
+/// bit; detection keeps the contacts with an owned side; the solve sees ghosts as bodies; the end
+/// of the step, the energies and the blow-up checks concern owned bodies only. A ghost is left at
+/// q_M: its owner advances it, and the driver refreshes it before the next step.
 ///
 /// The stepper keeps references to the three (they must outlive it) and owns every buffer of a
 /// step; after the first steps, a step of a settled system allocates nothing. Bodies may be
