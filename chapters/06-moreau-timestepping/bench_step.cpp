@@ -3,6 +3,8 @@
 //   BM_hooks/n  the solve of the same pile without solver hooks, with a velocity hook and with an
 //               after_iteration hook that do nothing: velocity_hook_over_none and
 //               iteration_hook_over_none, the solve times against the one without, same run.
+//   BM_skin/n   detection with and without a candidate list (skin r/5), same pile, same run:
+//               detection_skin_over_none, step_skin_over_none.
 //   BM_add/N    assembling N spheres: BodySystem::add (id check, validation) and
 //               CollisionWorld::add (the supported-pair check, O(1) per collider); seconds for N.
 //   BM_step/n   one step of the pile of n × n × n FCC cells (4n³ spheres, ≈ 6 contacts per
@@ -153,34 +155,43 @@ void BM_step(benchmark::State& state) {
   state.counters["bytes_per_body"] = bytes / N;
 }
 
+// A pile of n × n × n FCC cells with its own stepper (Δt = 2·10⁻⁴ s, exactly 100 SOR iterations a
+// step), stepped three times so that its buffers and warm starts are in place: the copies that
+// BM_hooks and BM_skin step in turn.
+struct SteppedPile {
+  timestep::BodySystem system;
+  timestep::StaticGeometry statics;
+  timestep::MaterialTable materials = demo::glass_materials();
+  std::unique_ptr<timestep::MoreauStepper> stepper;
+};
+
+std::unique_ptr<SteppedPile> stepped_pile(int n, double skin, timestep::StepHooks hooks = {}) {
+  auto pile = std::make_unique<SteppedPile>();
+  demo::fcc_pile(pile->system, pile->statics, n, n, n);
+  timestep::StepSettings settings;
+  settings.dt = 2e-4;
+  settings.solver.min_iterations = 100;
+  settings.solver.max_iterations = 100;
+  settings.skin = skin;
+  pile->stepper = std::make_unique<timestep::MoreauStepper>(pile->system, pile->statics,
+                                                            pile->materials, settings, hooks);
+  for (int warm = 0; warm < 3; ++warm) pile->stepper->step();
+  return pile;
+}
+
 // The cost of the solver's hooks: three copies of the pile stepped in turn, one without hooks,
 // one with a velocities_between_sweeps hook and one with an after_iteration hook, both doing
 // nothing; solve time of each against the one without, same run, same states.
 void BM_hooks(benchmark::State& state) {
   const int n = static_cast<int>(state.range(0));
-  struct Pile {
-    timestep::BodySystem system;
-    timestep::StaticGeometry statics;
-    timestep::MaterialTable materials = demo::glass_materials();
-    std::unique_ptr<timestep::MoreauStepper> stepper;
-  };
-  std::vector<std::unique_ptr<Pile>> piles;
+  std::vector<std::unique_ptr<SteppedPile>> piles;
   for (int kind = 0; kind < 3; ++kind) {
-    auto pile = std::make_unique<Pile>();
-    demo::fcc_pile(pile->system, pile->statics, n, n, n);
-    timestep::StepSettings settings;
-    settings.dt = 2e-4;
-    settings.solver.min_iterations = 100;
-    settings.solver.max_iterations = 100;
     timestep::StepHooks hooks;
     if (kind == 1) hooks.solver.velocities_between_sweeps = [](int, std::span<Vector6>) {};
     if (kind == 2) {
       hooks.solver.after_iteration = [](int, std::span<Vector3>, std::span<Vector6>) {};
     }
-    pile->stepper = std::make_unique<timestep::MoreauStepper>(pile->system, pile->statics,
-                                                              pile->materials, settings, hooks);
-    for (int warm = 0; warm < 3; ++warm) pile->stepper->step();
-    piles.push_back(std::move(pile));
+    piles.push_back(stepped_pile(n, 0.0, hooks));
   }
   double solve[3] = {0.0, 0.0, 0.0};
   for (auto _ : state) {
@@ -188,6 +199,29 @@ void BM_hooks(benchmark::State& state) {
   }
   state.counters["velocity_hook_over_none"] = solve[1] / solve[0];
   state.counters["iteration_hook_over_none"] = solve[2] / solve[0];
+}
+
+// The candidate list: two copies of the pile stepped in turn, one detecting from scratch at every
+// step, one with a skin of a fifth of the radius (StepSettings::skin); the detection stage of each
+// and their ratio, same run, same states (the lists give the same contacts, bit for bit).
+void BM_skin(benchmark::State& state) {
+  const int n = static_cast<int>(state.range(0));
+  std::vector<std::unique_ptr<SteppedPile>> piles;
+  for (const double skin : {0.0, 0.2e-3}) piles.push_back(stepped_pile(n, skin));
+  double detection[2] = {0.0, 0.0};
+  double total[2] = {0.0, 0.0};
+  for (auto _ : state) {
+    for (int kind = 0; kind < 2; ++kind) {
+      const timestep::StepReport report = piles[kind]->stepper->step();
+      detection[kind] += report.seconds.detection;
+      total[kind] += report.seconds.total;
+    }
+  }
+  const double steps = static_cast<double>(state.iterations());
+  state.counters["detection_ms"] = 1e3 * detection[0] / steps;
+  state.counters["detection_skin_ms"] = 1e3 * detection[1] / steps;
+  state.counters["detection_skin_over_none"] = detection[1] / detection[0];
+  state.counters["step_skin_over_none"] = total[1] / total[0];
 }
 
 void BM_add(benchmark::State& state) {
@@ -229,6 +263,7 @@ void BM_add(benchmark::State& state) {
 BENCHMARK(BM_add)->Arg(80000)->Arg(1000000)->Unit(benchmark::kMillisecond)->Iterations(1);
 BENCHMARK(BM_step)->Arg(6)->Arg(14)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_step)->Arg(29)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(3);
+BENCHMARK(BM_skin)->Arg(14)->Arg(29)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(5);
 BENCHMARK(BM_hooks)->Arg(14)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(5);
 
 // One step of the 63 × 63 × 63 pile, 1 000 188 spheres (about 10 GB with the body-form copy the

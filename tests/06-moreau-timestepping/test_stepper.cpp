@@ -442,8 +442,8 @@ TEST(Identity, PermutingTheBodiesBetweenStepsChangesNothing) {
   }
 }
 
-TEST(Identity, SameInputGivesBitIdenticalOutputAndReorderingKeepsIt) {
-  const auto run = [](int reorder_interval) {
+TEST(Identity, SameInputGivesBitIdenticalOutputAndReorderingOrACandidateListKeepsIt) {
+  const auto run = [](int reorder_interval, double skin = 0.0) {
     BodySystem system;
     StaticGeometry statics;
     demo::add_open_box(statics, 0.12, 0.12);
@@ -452,6 +452,7 @@ TEST(Identity, SameInputGivesBitIdenticalOutputAndReorderingKeepsIt) {
     StepSettings settings;
     settings.dt = 1e-3;
     settings.reorder_interval = reorder_interval;
+    settings.skin = skin;
     MoreauStepper stepper(system, statics, materials, settings);
     int reordered = 0;
     for (int step = 0; step < 100; ++step) {
@@ -470,10 +471,15 @@ TEST(Identity, SameInputGivesBitIdenticalOutputAndReorderingKeepsIt) {
   const auto first = run(0);
   const auto again = run(0);
   const auto reordered = run(7);
+  const auto listed = run(0, 0.002);            // a skin of a fifth of the radius
+  const auto listed_reordered = run(7, 0.002);  // reordering rebuilds the list
   for (std::size_t i = 0; i < first.size(); ++i) {
     ASSERT_EQ(first[i].second.q, again[i].second.q);
     ASSERT_EQ(first[i].second.q, reordered[i].second.q);
     ASSERT_EQ(first[i].second.u, reordered[i].second.u);
+    ASSERT_EQ(first[i].second.q, listed[i].second.q);
+    ASSERT_EQ(first[i].second.u, listed[i].second.u);
+    ASSERT_EQ(first[i].second.q, listed_reordered[i].second.q);
   }
 }
 
@@ -673,6 +679,9 @@ TEST(Stepper, RefusesBadSettingsMissingMaterialPairsAndUnsupportedShapePairs) {
   EXPECT_THROW(MoreauStepper(system, statics, materials, bad), InvalidArgument);
   bad = {};
   bad.drift_correction = 2.0;
+  EXPECT_THROW(MoreauStepper(system, statics, materials, bad), InvalidArgument);
+  bad = {};
+  bad.skin = -1e-3;
   EXPECT_THROW(MoreauStepper(system, statics, materials, bad), InvalidArgument);
   materials.set_pair(1, 1, {0.5, 0.0, 0.0});
   system.add(demo::box_body(2, Vector3(0.1, 0.1, 0.1), Vector3(1.0, 0.0, 1.0)));

@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <numeric>
 #include <random>
 #include <string>
@@ -16,6 +17,7 @@
 #include "grbd/timestep/body_system.hpp"
 #include "grbd/timestep/contacts.hpp"
 #include "grbd/timestep/materials.hpp"
+#include "grbd_test/messages.hpp"
 #include "scenes.hpp"
 
 namespace grbd::timestep {
@@ -23,14 +25,7 @@ namespace {
 
 using demo::sphere_body;
 
-std::string message_of(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const InvalidArgument& e) {
-    return e.what();
-  }
-  return "(no exception)";
-}
+using test::message_of;
 
 BodySystem ten_spheres() {
   BodySystem system;
@@ -254,6 +249,57 @@ TEST(ContactDetector, KeysAndOrderDoNotDependOnTheStorageOrder) {
     EXPECT_EQ(a.ids()[static_cast<std::size_t>(ca[k].body_a)],
               b.ids()[static_cast<std::size_t>(cb[k].body_a)]);
   }
+}
+
+// The candidate list with a skin (a Verlet list): over random motion, the contacts are those of
+// detection from scratch, bit for bit, while the list is built far less often.
+TEST(ContactDetector, ACandidateListWithASkinFindsExactlyTheContactsOfDetectionFromScratch) {
+  BodySystem system;
+  StaticGeometry statics;
+  demo::add_open_box(statics, 0.2, 0.2);
+  std::mt19937_64 rng(19);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  GlobalId id = 1;
+  for (int k = 0; k < 400; ++k) {
+    const double r = 0.004 + 0.004 * u(rng);
+    system.add(sphere_body(id++, r, Vector3(0.01 + 0.18 * u(rng), 0.01 + 0.18 * u(rng),
+                                            0.005 + 0.1 * u(rng))));
+  }
+  const double skin = 0.002;
+  ContactDetector scratch;
+  ContactDetector listed;
+  listed.set_skin(skin);
+  std::vector<DetectedContact> a, b;
+  std::vector<ContactKey> ka, kb;
+  std::size_t total = 0;
+  for (int step = 0; step < 300; ++step) {
+    // Random steps of at most skin/20 per axis: the list lasts a few steps, then is rebuilt.
+    for (body::State& x : system.states()) {
+      for (int d = 0; d < 3; ++d) x.q[d] += (u(rng) - 0.5) * 0.1 * skin;
+    }
+    if (step == 150) {  // a layout change forces a new list
+      const std::size_t gone[] = {7, 99};
+      system.remove(gone);
+    }
+    const double margin = 1e-4;
+    scratch.detect(system, statics, margin, a, ka);
+    listed.detect(system, statics, margin, b, kb);
+    ASSERT_EQ(ka, kb) << "step " << step;
+    for (std::size_t k = 0; k < ka.size(); ++k) {
+      ASSERT_EQ(a[k].geometry.g_N, b[k].geometry.g_N);
+      ASSERT_EQ(a[k].geometry.I_n, b[k].geometry.I_n);
+      ASSERT_EQ(a[k].geometry.I_r_a, b[k].geometry.I_r_a);
+      ASSERT_EQ(a[k].body_a, b[k].body_a);
+      ASSERT_EQ(a[k].body_b, b[k].body_b);
+    }
+    total += ka.size();
+  }
+  EXPECT_GT(total, 300u * 100u);  // the spheres are dense enough to touch
+  EXPECT_EQ(scratch.list_builds(), 300u);
+  EXPECT_GT(listed.list_builds(), 5u);    // rebuilt as the spheres wander …
+  EXPECT_LT(listed.list_builds(), 100u);  // … but kept for several steps each time
+  EXPECT_THROW(listed.set_skin(-1.0), InvalidArgument);
+  EXPECT_THROW(listed.set_skin(std::nan("")), InvalidArgument);
 }
 
 TEST(CollisionWorldAdd, TheConstantTimePairCheckNamesTheFirstConflictingCollider) {

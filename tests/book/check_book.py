@@ -37,7 +37,8 @@ CHAPTERS = ["ch" + folder.name.replace("-", "_")
             for folder in sorted(ROOT.glob("chapters/[0-9][0-9]-*")) if (folder / "chapter.md").exists()]
 # Chapters that are written (not only an outline): they must quote code and show figures.
 WRITTEN = ["ch01_kinematics", "ch02_rigid_bodies", "ch03_smooth_references", "ch04_collision",
-           "ch05_contact_laws", "ch06_moreau_timestepping", "ch07_simulation_framework"]
+           "ch05_contact_laws", "ch06_moreau_timestepping", "ch07_simulation_framework",
+           "ch08_parallel_chute_flow"]
 RESOURCE = re.compile(r'<(?:script|img|link|object)\b[^>]*?\b(?:src|href|data)="([^"]+)"', re.I)
 # MathJax files the book's configuration loads (the rest is loaded on demand by these).
 MATHJAX_FILES = ["MathJax.js", "jax/input/TeX/config.js", "jax/input/TeX/jax.js",

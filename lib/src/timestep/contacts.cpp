@@ -171,19 +171,27 @@ void ContactDetector::detect(const BodySystem& system, const StaticGeometry& sta
     }
   }
   if (sphere_bodies_.size() >= 2) {
-    // The grid's test is strict, |c_i − c_j| < r_i + r_j + margin; a margin wider by 10⁻⁹ r_max
-    // lets touching spheres (g_N = 0 exactly: a column at rest, a cradle) reach the narrow phase,
-    // which keeps g_N ≤ margin.
-    const double r_max = *std::max_element(radii_.begin(), radii_.end());
-    grid_.build(centres_, radii_, margin + 1e-9 * r_max);
-    grid_.find_pairs(pairs_);
-    for (const auto& [i, j] : pairs_) {
-      const auto a = static_cast<std::size_t>(sphere_bodies_[static_cast<std::size_t>(i)]);
-      const auto b = static_cast<std::size_t>(sphere_bodies_[static_cast<std::size_t>(j)]);
-      if (!system.dynamic(a) && !system.dynamic(b)) continue;
-      if (!system.owned(a) && !system.owned(b)) continue;  // two ghosts: another process's pair
-      pair({true, a}, {true, b});
+    if (!list_is_valid(system, margin)) {
+      // The grid's test is strict, |c_i − c_j| < r_i + r_j + margin; a margin wider by 10⁻⁹ r_max
+      // lets touching spheres (g_N = 0 exactly: a column at rest, a cradle) reach the narrow
+      // phase, which keeps g_N ≤ margin. The skin widens it for the steps the list is kept.
+      const double r_max = *std::max_element(radii_.begin(), radii_.end());
+      grid_.build(centres_, radii_, margin + 1e-9 * r_max + skin_);
+      grid_.find_pairs(pairs_);
+      candidates_.clear();
+      for (const auto& [i, j] : pairs_) {
+        const auto a = static_cast<std::size_t>(sphere_bodies_[static_cast<std::size_t>(i)]);
+        const auto b = static_cast<std::size_t>(sphere_bodies_[static_cast<std::size_t>(j)]);
+        if (!system.dynamic(a) && !system.dynamic(b)) continue;
+        if (!system.owned(a) && !system.owned(b)) continue;  // two ghosts: another process's pair
+        candidates_.emplace_back(a, b);
+      }
+      built_centres_.assign(centres_.begin(), centres_.end());
+      built_layout_ = system.layout_version();
+      built_margin_ = margin;
+      ++list_builds_;
     }
+    for (const auto& [a, b] : candidates_) pair({true, a}, {true, b});
   }
   // Boxes and capsules against every other body whose bounding sphere they touch; a pair of two
   // non-spheres is visited from the smaller index only.
@@ -254,6 +262,35 @@ void ContactDetector::detect(const BodySystem& system, const StaticGeometry& sta
   permute_in_place(permutation_, contacts, keys);
 }
 // [detect system]
+
+void ContactDetector::set_skin(double skin) {
+  if (!(skin >= 0.0) || !std::isfinite(skin)) {
+    throw InvalidArgument("ContactDetector::set_skin: expected a finite skin >= 0 [m], found " +
+                          format_number(skin));
+  }
+  skin_ = skin;
+  built_layout_ = ~std::uint64_t{0};  // the next detect() builds the list
+}
+
+// [skin list]
+// The list holds every pair that was within margin + skin when it was built. A pair outside it
+// was then at least r_i + r_j + margin + skin apart; while no sphere has moved more than skin/2,
+// it is still at least r_i + r_j + margin apart and cannot be a contact.
+bool ContactDetector::list_is_valid(const BodySystem& system, double margin) const {
+  if (skin_ == 0.0 || system.layout_version() != built_layout_ || margin > built_margin_ ||
+      built_centres_.size() != centres_.size()) {
+    return false;
+  }
+  // Half the skin, less a relative 10⁻¹², so that rounding of the displacement never keeps a
+  // list one ulp too long.
+  const double half = 0.5 * skin_ * (1.0 - 1e-12);
+  const double limit = half * half;
+  for (std::size_t k = 0; k < centres_.size(); ++k) {
+    if ((centres_[k] - built_centres_[k]).squaredNorm() > limit) return false;
+  }
+  return true;
+}
+// [skin list]
 
 void WarmStartTable::clear() {
   keys_.clear();

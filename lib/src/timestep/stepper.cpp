@@ -44,6 +44,10 @@ void require_settings(const StepSettings& s) {
     throw InvalidArgument(where + "expected a finite contact_tolerance >= 0, found " +
                           format_number(s.contact_tolerance));
   }
+  if (!(s.skin >= 0.0) || !std::isfinite(s.skin)) {
+    throw InvalidArgument(where + "expected a finite skin >= 0 [m] (0: no candidate list), found " +
+                          format_number(s.skin));
+  }
   if (!(s.drift_correction >= 0.0 && s.drift_correction <= 1.0)) {
     throw InvalidArgument(where + "expected drift_correction in [0, 1] (0: off), found " +
                           format_number(s.drift_correction));
@@ -82,6 +86,7 @@ MoreauStepper::MoreauStepper(BodySystem& system, const StaticGeometry& statics,
       settings_((require_settings(settings), settings)),
       hooks_(std::move(hooks)),
       solver_(settings.method, settings.solver, hooks_.solver) {
+  detector_.set_skin(settings_.skin);
   check_layout();
 }
 

@@ -63,12 +63,34 @@ class ContactDetector {
   void detect(const BodySystem& system, const StaticGeometry& statics, double margin,
               std::vector<DetectedContact>& contacts, std::vector<ContactKey>& keys);
 
+  /// The skin of the candidate list of sphere pairs [m] (a Verlet list; 0, the default: no list,
+  /// the cell grid runs at every detect()). With a skin s > 0, the grid finds the pairs within
+  /// margin + s and detect() keeps testing that list until some sphere has moved more than s/2
+  /// from where it was when the list was built, or the bodies were added, removed or reordered
+  /// (BodySystem::layout_version), or the margin grew: two spheres absent from the list are then
+  /// still more than the margin apart, and the contacts are exactly those of detection from
+  /// scratch, bit for bit. Throws InvalidArgument unless s ≥ 0 and finite.
+  void set_skin(double skin);
+  /// The skin [m].
+  double skin() const { return skin_; }
+  /// How often the candidate list was built (every detect() with skin 0).
+  std::uint64_t list_builds() const { return list_builds_; }
+
  private:
+  bool list_is_valid(const BodySystem& system, double margin) const;
+
   collision::CellGrid grid_;
   std::vector<Vector3> centres_;
   std::vector<double> radii_;
   std::vector<std::int32_t> sphere_bodies_;
   std::vector<collision::IndexPair> pairs_;
+  // The candidate list: sphere pairs as body indices, and what it was built for.
+  double skin_ = 0.0;
+  std::vector<std::pair<std::size_t, std::size_t>> candidates_;
+  std::vector<Vector3> built_centres_;  // of sphere_bodies_, when the list was built
+  std::uint64_t built_layout_ = ~std::uint64_t{0};
+  double built_margin_ = -1.0;
+  std::uint64_t list_builds_ = 0;
   std::vector<std::size_t> others_;  // dynamic non-spheres and fixed bodies
   std::vector<collision::Placement> placements_;
   std::vector<collision::ContactGeometry> found_;

@@ -64,6 +64,10 @@ struct StepSettings {
   /// holds. 0: the smallest bounding radius among the bodies when the stepper first sees any,
   /// kept from then on.
   double tolerance_radius = 0.0;
+  /// Skin of detection's candidate list of sphere pairs [m], ≥ 0 and finite (0: none, the cell
+  /// grid at every step): the list is rebuilt only when a sphere has moved more than half of it
+  /// (ContactDetector::set_skin), with exactly the contacts of detection from scratch.
+  double skin = 0.0;
   /// Penetration drift correction β ∈ [0, 1] (0: off, the default): after the step, each active
   /// contact with g_N(q_M) < 0 pushes its bodies apart by β|g_N| along the normal (positions
   /// only, velocities untouched), shared by inverse mass and divided among the contacts of a body.

@@ -1,0 +1,83 @@
+#pragma once
+/// \file
+/// \brief The domain split among processes (chapter 8): a Cartesian grid of subdomains, the owner
+/// of a position, and whether a body reaches into a subdomain.
+
+#include <Eigen/Geometry>
+#include <array>
+#include <vector>
+
+#include "grbd/core/types.hpp"
+
+namespace grbd::parallel {
+
+/// An axis-aligned box [min, max] in frame I [m].
+using Box = Eigen::AlignedBox3d;
+
+/// The number of subdomains along x, y and z for `processes` processes over a domain of the given
+/// extents: of all factorisations n_x n_y n_z = P, the one whose interfaces between subdomains
+/// have the least area, Σ_d (n_d − 1) A_d with A_d the domain's cross-section normal to axis d
+/// (ties: more cuts along x, then y). A long chute is cut along its length, a cube into cubes.
+/// MPI_Dims_create ignores the domain's shape. Throws InvalidArgument for P < 1 or an extent that
+/// is not positive and finite.
+std::array<int, 3> grid_dims(int processes, const Vector3& extent);
+
+/// A Cartesian grid of n_x × n_y × n_z subdomains over a domain box: subdomain (i, j, k) is
+/// [b^x_i, b^x_{i+1}) × [b^y_j, b^y_{j+1}) × [b^z_k, b^z_{k+1}) with b^d_i = min_d + i L_d / n_d,
+/// and belongs to rank i + n_x (j + n_y k). A position outside the domain belongs to the nearest
+/// subdomain along each non-periodic axis; along a periodic axis it is wrapped into the domain
+/// first. Every process builds the same grid from the same numbers and so agrees on every owner.
+class CartesianGrid {
+ public:
+  /// Throws InvalidArgument for an empty or non-finite domain, or dims < 1.
+  CartesianGrid(const Box& domain, const std::array<int, 3>& dims,
+                const std::array<bool, 3>& periodic = {false, false, false});
+
+  /// Number of subdomains (= processes).
+  int size() const { return dims_[0] * dims_[1] * dims_[2]; }
+  /// Subdomains along x, y, z.
+  const std::array<int, 3>& dims() const { return dims_; }
+  /// The whole domain.
+  const Box& domain() const { return domain_; }
+  /// Whether each axis is periodic.
+  const std::array<bool, 3>& periodic() const { return periodic_; }
+  /// The boundaries b^d_0 … b^d_{n_d} along axis d (the first and last are the domain's).
+  const std::vector<double>& boundaries(int axis) const { return boundaries_[axis]; }
+
+  /// The cell (i, j, k) of a rank, and the rank of a cell.
+  std::array<int, 3> cell_of(int rank) const;
+  int rank_of(const std::array<int, 3>& cell) const;  ///< i + n_x (j + n_y k)
+  /// The box of a rank's subdomain.
+  Box subdomain(int rank) const;
+
+  /// A position moved into the domain along the periodic axes (unchanged along the others).
+  Vector3 wrap(const Vector3& position) const;
+  // [owner of]
+  /// The rank that owns a position: along each axis the cell whose [b_i, b_{i+1}) holds the
+  /// wrapped position (a position on a boundary belongs to the cell above it; outside the domain,
+  /// to the first or last cell). Exercise 8.1.
+  int owner_of(const Vector3& position) const;
+  // [owner of]
+
+  /// The ranks whose subdomain, or a periodic image of it, lies within `reach` of the subdomain of
+  /// `rank` (distance between the boxes ≤ reach), sorted, each once; `rank` itself only through a
+  /// periodic image (an axis with one or two subdomains). The processes that must exchange
+  /// ghosts with `rank` when bodies interact up to `reach`.
+  std::vector<int> neighbours(int rank, double reach) const;
+
+ private:
+  Box domain_;
+  std::array<int, 3> dims_;
+  std::array<bool, 3> periodic_;
+  std::array<std::vector<double>, 3> boundaries_;
+};
+
+// [overlaps]
+/// True when a sphere of radius `reach` about `centre` meets the box (its closed set): the
+/// distance from the centre to the box is at most reach. A body of bounding radius r whose
+/// contacts reach a margin m further must be known to every subdomain it overlaps with reach
+/// r + m. Exercise 8.2.
+bool overlaps(const Vector3& centre, double reach, const Box& box);
+// [overlaps]
+
+}  // namespace grbd::parallel

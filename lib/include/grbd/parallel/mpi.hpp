@@ -1,0 +1,78 @@
+#pragma once
+/// \file
+/// \brief MPI for a program (chapter 8): the environment that starts and ends it, the communicator
+/// of all processes, and the one way an error ends a parallel run. MPI's own types stay in the
+/// implementation; what the rest of grbd sees is a grbd::Communicator.
+
+#include <memory>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "grbd/core/communicator.hpp"
+
+namespace grbd::parallel {
+
+/// True when this process was started by an MPI launcher (mpirun, mpiexec, srun with PMIx): the
+/// launcher's environment variables are set. A program started alone then runs the serial path
+/// and never initialises MPI.
+bool launched_by_mpi();
+
+/// The communicator of every process of the run, MPI_COMM_WORLD (or a duplicate of a given
+/// communicator). Collective operations as grbd::Communicator promises; a failing MPI call ends
+/// every process through abort_run().
+class MpiCommunicator final : public Communicator {
+ public:
+  /// A duplicate of MPI_COMM_WORLD, so that grbd's messages never meet a caller's.
+  MpiCommunicator();
+  ~MpiCommunicator() override;
+  MpiCommunicator(const MpiCommunicator&) = delete;
+  MpiCommunicator& operator=(const MpiCommunicator&) = delete;
+
+  int rank() const override;
+  int size() const override;
+  void sum(std::span<double> values) const override;
+  void sum(std::span<std::uint64_t> values) const override;
+  void max(std::span<double> values) const override;
+  void min(std::span<double> values) const override;
+  bool all(bool value) const override;
+  void broadcast(std::vector<std::byte>& bytes, int root) const override;
+  void all_gather(std::span<const std::byte> mine,
+                  std::vector<std::vector<std::byte>>& all) const override;
+  void exchange(std::span<const int> neighbours, std::span<const std::vector<std::byte>> send,
+                std::vector<std::vector<std::byte>>& received) const override;
+  void barrier() const override;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+  int rank_ = 0;
+  int size_ = 1;
+};
+
+/// MPI for the lifetime of a program: initialised by the constructor when the program was
+/// launched by MPI (launched_by_mpi()) or when `force` is set, finalised by the destructor. Only
+/// one may exist. Without MPI, world() is the one-process communicator.
+class MpiEnvironment {
+ public:
+  /// Initialises MPI (thread level MPI_THREAD_FUNNELED) if launched by MPI or `force`.
+  explicit MpiEnvironment(bool force = false);
+  ~MpiEnvironment();
+  MpiEnvironment(const MpiEnvironment&) = delete;
+  MpiEnvironment& operator=(const MpiEnvironment&) = delete;
+
+  /// True when MPI is initialised.
+  bool active() const { return world_ != nullptr; }
+  /// All processes of the run (the one-process communicator without MPI).
+  const Communicator& world() const;
+
+ private:
+  std::unique_ptr<MpiCommunicator> world_;
+};
+
+/// Ends a parallel run from any rank: prints "grbd: rank R: <message>" once on stderr and ends
+/// every process with `exit_code` (MPI_Abort); without MPI, prints "grbd: <message>" and exits.
+/// The way an error that only some ranks see ends all of them, never a hang.
+[[noreturn]] void abort_run(const std::string& message, int exit_code);
+
+}  // namespace grbd::parallel

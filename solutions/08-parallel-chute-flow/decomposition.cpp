@@ -1,0 +1,173 @@
+/// \file
+/// \brief The Cartesian decomposition of the domain; chapter 8 exercises: the owner of a position
+/// and the overlap of a body with a subdomain.
+
+#include "grbd/parallel/decomposition.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <string>
+
+#include "grbd/core/checks.hpp"
+#include "grbd/core/error.hpp"
+
+namespace grbd::parallel {
+
+namespace {
+
+void require_extent(const Vector3& extent, const char* where) {
+  for (int d = 0; d < 3; ++d) {
+    if (!(extent[d] > 0.0) || !std::isfinite(extent[d])) {
+      throw InvalidArgument(std::string(where) + ": expected a domain of positive, finite extent, "
+                            "found " + format_number(extent[0]) + " × " +
+                            format_number(extent[1]) + " × " + format_number(extent[2]) + " m");
+    }
+  }
+}
+
+}  // namespace
+
+std::array<int, 3> grid_dims(int processes, const Vector3& extent) {
+  if (processes < 1) {
+    throw InvalidArgument("grid_dims: expected at least one process, found " +
+                          std::to_string(processes));
+  }
+  require_extent(extent, "grid_dims");
+  const Vector3 cross(extent.y() * extent.z(), extent.x() * extent.z(), extent.x() * extent.y());
+  std::array<int, 3> best{processes, 1, 1};
+  double best_area = std::numeric_limits<double>::infinity();
+  for (int nx = processes; nx >= 1; --nx) {
+    if (processes % nx != 0) continue;
+    for (int ny = processes / nx; ny >= 1; --ny) {
+      if ((processes / nx) % ny != 0) continue;
+      const int nz = processes / nx / ny;
+      const double area = (nx - 1) * cross.x() + (ny - 1) * cross.y() + (nz - 1) * cross.z();
+      if (area < best_area * (1.0 - 1e-12)) {  // ties keep the earlier: more cuts along x, then y
+        best_area = area;
+        best = {nx, ny, nz};
+      }
+    }
+  }
+  return best;
+}
+
+CartesianGrid::CartesianGrid(const Box& domain, const std::array<int, 3>& dims,
+                             const std::array<bool, 3>& periodic)
+    : domain_(domain), dims_(dims), periodic_(periodic) {
+  if (!domain.min().allFinite() || !domain.max().allFinite()) {
+    throw InvalidArgument("CartesianGrid: expected a finite domain");
+  }
+  require_extent(domain.sizes(), "CartesianGrid");
+  for (int d = 0; d < 3; ++d) {
+    if (dims[d] < 1) {
+      throw InvalidArgument("CartesianGrid: expected at least one subdomain along each axis, "
+                            "found " + std::to_string(dims[0]) + " × " + std::to_string(dims[1]) +
+                            " × " + std::to_string(dims[2]));
+    }
+    std::vector<double>& b = boundaries_[d];
+    b.resize(static_cast<std::size_t>(dims[d]) + 1);
+    for (int i = 0; i <= dims[d]; ++i) {
+      b[static_cast<std::size_t>(i)] =
+          i == dims[d] ? domain.max()[d]
+                       : domain.min()[d] + (domain.max()[d] - domain.min()[d]) * i / dims[d];
+    }
+  }
+}
+
+std::array<int, 3> CartesianGrid::cell_of(int rank) const {
+  if (rank < 0 || rank >= size()) {
+    throw InvalidArgument("CartesianGrid: expected a rank in [0, " + std::to_string(size()) +
+                          "), found " + std::to_string(rank));
+  }
+  return {rank % dims_[0], (rank / dims_[0]) % dims_[1], rank / (dims_[0] * dims_[1])};
+}
+
+int CartesianGrid::rank_of(const std::array<int, 3>& cell) const {
+  return cell[0] + dims_[0] * (cell[1] + dims_[1] * cell[2]);
+}
+
+Box CartesianGrid::subdomain(int rank) const {
+  const std::array<int, 3> c = cell_of(rank);
+  Vector3 lo, hi;
+  for (int d = 0; d < 3; ++d) {
+    lo[d] = boundaries_[d][static_cast<std::size_t>(c[d])];
+    hi[d] = boundaries_[d][static_cast<std::size_t>(c[d]) + 1];
+  }
+  return Box(lo, hi);
+}
+
+Vector3 CartesianGrid::wrap(const Vector3& position) const {
+  Vector3 x = position;
+  for (int d = 0; d < 3; ++d) {
+    if (!periodic_[d]) continue;
+    const double lo = domain_.min()[d];
+    const double length = domain_.max()[d] - lo;
+    x[d] -= length * std::floor((x[d] - lo) / length);
+    if (x[d] >= domain_.max()[d]) x[d] = lo;  // x a hair below lo rounds up to max
+  }
+  return x;
+}
+
+int CartesianGrid::owner_of(const Vector3& position) const {
+  // BEGIN EXERCISE 8.1: the owner of a position
+  // Hint: wrap() the position; along each axis d count the interior boundaries b_1 … b_{n−1}
+  //   (boundaries_[d]) that are ≤ x_d (std::upper_bound): that count is the cell index, already
+  //   clamped to [0, n − 1]; then rank_of(cell).
+  const Vector3 x = wrap(position);
+  std::array<int, 3> cell{};
+  for (int d = 0; d < 3; ++d) {
+    // The interior boundaries b_1 … b_{n−1} at or below x: the cell whose [b_i, b_{i+1}) holds x,
+    // clamped to the first and last cell outside the domain.
+    const std::vector<double>& b = boundaries_[d];
+    const auto above = std::upper_bound(b.begin() + 1, b.end() - 1, x[d]);
+    cell[d] = static_cast<int>(above - (b.begin() + 1));
+  }
+  return rank_of(cell);
+  // END EXERCISE 8.1
+}
+
+std::vector<int> CartesianGrid::neighbours(int rank, double reach) const {
+  if (!(reach >= 0.0) || !std::isfinite(reach)) {
+    throw InvalidArgument("CartesianGrid::neighbours: expected a finite reach >= 0, found " +
+                          format_number(reach));
+  }
+  const Box mine = subdomain(rank);
+  const Vector3 length = domain_.sizes();
+  std::vector<int> found;
+  for (int other = 0; other < size(); ++other) {
+    const Box box = subdomain(other);
+    // Its images: shifted by −L, 0, +L along each periodic axis.
+    for (int sx = -1; sx <= 1; ++sx) {
+      for (int sy = -1; sy <= 1; ++sy) {
+        for (int sz = -1; sz <= 1; ++sz) {
+          const std::array<int, 3> s{sx, sy, sz};
+          bool valid = true;
+          Vector3 shift = Vector3::Zero();
+          for (int d = 0; d < 3; ++d) {
+            if (s[d] != 0 && !periodic_[d]) valid = false;
+            shift[d] = s[d] * length[d];
+          }
+          if (!valid || (other == rank && s == std::array<int, 3>{0, 0, 0})) continue;
+          const Box image(box.min() + shift, box.max() + shift);
+          if (mine.exteriorDistance(image) <= reach) found.push_back(other);
+        }
+      }
+    }
+  }
+  std::sort(found.begin(), found.end());
+  found.erase(std::unique(found.begin(), found.end()), found.end());
+  return found;
+}
+
+bool overlaps(const Vector3& centre, double reach, const Box& box) {
+  // BEGIN EXERCISE 8.2: does a body reach into a subdomain?
+  // Hint: the point of the box closest to the centre is the centre clamped to [min, max] axis by
+  //   axis; compare squared distances, so that no square root rounds a touching body away.
+  // The point of the box closest to the centre is the centre clamped to the box.
+  const Vector3 closest = centre.cwiseMax(box.min()).cwiseMin(box.max());
+  return (closest - centre).squaredNorm() <= reach * reach;
+  // END EXERCISE 8.2
+}
+
+}  // namespace grbd::parallel

@@ -1,0 +1,139 @@
+// Chapter 8: the Cartesian decomposition. References: the subdomain boxes themselves (every
+// position lies in the half-open box of exactly one rank, the one owner_of names), brute-force
+// distances for the overlap, and the interface areas of every factorisation for grid_dims.
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+#include <vector>
+
+#include "grbd/core/error.hpp"
+#include "grbd/parallel/decomposition.hpp"
+
+namespace grbd::parallel {
+namespace {
+
+// Whether x lies in the half-open box [min, max) of a subdomain, closed at the domain's far side.
+bool holds(const CartesianGrid& grid, int rank, const Vector3& x) {
+  const Box box = grid.subdomain(rank);
+  for (int d = 0; d < 3; ++d) {
+    const bool last = box.max()[d] == grid.domain().max()[d];
+    if (x[d] < box.min()[d] || (last ? x[d] > box.max()[d] : x[d] >= box.max()[d])) return false;
+  }
+  return true;
+}
+
+TEST(Exercise8_1, EveryPositionInTheDomainHasExactlyTheOwnerWhoseBoxHoldsIt) {
+  const CartesianGrid grid(Box(Vector3(-0.3, 0.0, 1.0), Vector3(0.7, 0.2, 1.3)), {5, 3, 2});
+  std::mt19937_64 rng(3);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  for (int k = 0; k < 20000; ++k) {
+    const Vector3 x = grid.domain().min() +
+                      Vector3(u(rng), u(rng), u(rng)).cwiseProduct(grid.domain().sizes());
+    const int owner = grid.owner_of(x);
+    ASSERT_GE(owner, 0);
+    ASSERT_LT(owner, grid.size());
+    int holders = 0;
+    for (int r = 0; r < grid.size(); ++r) holders += holds(grid, r, x) ? 1 : 0;
+    ASSERT_EQ(holders, 1);
+    ASSERT_TRUE(holds(grid, owner, x)) << "x = " << x.transpose();
+  }
+}
+
+TEST(Exercise8_1, BoundariesGoToTheCellAboveAndOutsidePositionsToTheNearestCell) {
+  const CartesianGrid grid(Box(Vector3(0, 0, 0), Vector3(4, 2, 1)), {4, 2, 1});
+  // On the interior boundary x = 1 (exactly b^x_1): the cell above.
+  EXPECT_EQ(grid.owner_of(Vector3(1.0, 0.5, 0.5)), grid.rank_of({1, 0, 0}));
+  EXPECT_EQ(grid.owner_of(Vector3(std::nextafter(1.0, 0.0), 0.5, 0.5)), grid.rank_of({0, 0, 0}));
+  EXPECT_EQ(grid.owner_of(Vector3(3.0, 1.0, 0.5)), grid.rank_of({3, 1, 0}));
+  // Outside: clamped, axis by axis.
+  EXPECT_EQ(grid.owner_of(Vector3(-5.0, 0.5, 0.5)), grid.rank_of({0, 0, 0}));
+  EXPECT_EQ(grid.owner_of(Vector3(9.0, 7.0, -3.0)), grid.rank_of({3, 1, 0}));
+  EXPECT_EQ(grid.owner_of(Vector3(4.0, 2.0, 1.0)), grid.rank_of({3, 1, 0}));  // far corner
+  // Every cell's centre belongs to its rank.
+  for (int r = 0; r < grid.size(); ++r) EXPECT_EQ(grid.owner_of(grid.subdomain(r).center()), r);
+}
+
+TEST(Exercise8_1, PeriodicAxesWrapBeforeTheOwnerIsFound) {
+  const CartesianGrid grid(Box(Vector3(0, 0, 0), Vector3(3, 1, 1)), {3, 1, 1},
+                           {true, false, false});
+  EXPECT_EQ(grid.owner_of(Vector3(-0.5, 0.5, 0.5)), 2);  // one period back: x = 2.5
+  EXPECT_EQ(grid.owner_of(Vector3(3.0, 0.5, 0.5)), 0);   // x = L is x = 0
+  EXPECT_EQ(grid.owner_of(Vector3(7.2, 0.5, 0.5)), 1);   // two periods on: x = 1.2
+  // −10⁻¹⁷ + 3 rounds to 3 = L, which is 0: wrapping never leaves a position on the far side.
+  EXPECT_EQ(grid.wrap(Vector3(-1e-17, 0.5, 0.5)).x(), 0.0);
+  EXPECT_EQ(grid.owner_of(Vector3(-1e-17, 0.5, 0.5)), 0);
+  EXPECT_EQ(grid.wrap(Vector3(-0.5, 9.0, 0.5)), Vector3(2.5, 9.0, 0.5));  // y is not periodic
+}
+
+TEST(Exercise8_2, ASphereOverlapsABoxWhenItsDistanceToTheBoxIsAtMostItsReach) {
+  const Box box(Vector3(0, 0, 0), Vector3(1, 2, 3));
+  EXPECT_TRUE(overlaps(Vector3(0.5, 0.5, 0.5), 0.0, box));    // inside
+  EXPECT_TRUE(overlaps(Vector3(-0.25, 1.0, 1.0), 0.25, box));  // touching a face
+  EXPECT_FALSE(overlaps(Vector3(-0.25, 1.0, 1.0), 0.2499, box));
+  EXPECT_TRUE(overlaps(Vector3(-3.0, -4.0, 1.0), 5.0, box));  // touching an edge: 3-4-5
+  EXPECT_FALSE(overlaps(Vector3(-3.0, -4.0, 1.0), 4.999, box));
+  EXPECT_TRUE(overlaps(Vector3(2.0, 4.0, 5.0), 3.0, box));  // the far corner: (1, 2, 2) away
+  EXPECT_FALSE(overlaps(Vector3(2.0, 4.0, 5.0), 2.999, box));
+  // Against the distance to a dense sampling of the box's surface and inside.
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> u(-2.0, 4.0);
+  for (int k = 0; k < 2000; ++k) {
+    const Vector3 c(u(rng), u(rng), u(rng));
+    double distance = 0.0;
+    for (int d = 0; d < 3; ++d) {
+      const double outside = std::max({box.min()[d] - c[d], 0.0, c[d] - box.max()[d]});
+      distance += outside * outside;
+    }
+    distance = std::sqrt(distance);
+    EXPECT_EQ(overlaps(c, distance * (1 + 1e-12) + 1e-300, box), true);
+    if (distance > 0.0) {
+      EXPECT_EQ(overlaps(c, distance * (1 - 1e-12), box), false);
+    }
+  }
+}
+
+TEST(GridDims, CutsTheDomainWhereTheInterfacesAreSmallest) {
+  EXPECT_EQ(grid_dims(1, Vector3(1, 1, 1)), (std::array<int, 3>{1, 1, 1}));
+  EXPECT_EQ(grid_dims(8, Vector3(1, 1, 1)), (std::array<int, 3>{2, 2, 2}));
+  EXPECT_EQ(grid_dims(7, Vector3(1, 5, 1)), (std::array<int, 3>{1, 7, 1}));  // a prime: one axis
+  EXPECT_EQ(grid_dims(4, Vector3(10, 1, 0.1)), (std::array<int, 3>{4, 1, 1}));  // a chute
+  // Against every factorisation: no other has smaller interfaces.
+  for (int p = 1; p <= 64; ++p) {
+    const Vector3 L(3.0, 1.0, 0.4);
+    const auto area = [&](int nx, int ny, int nz) {
+      return (nx - 1) * L.y() * L.z() + (ny - 1) * L.x() * L.z() + (nz - 1) * L.x() * L.y();
+    };
+    const std::array<int, 3> d = grid_dims(p, L);
+    ASSERT_EQ(d[0] * d[1] * d[2], p);
+    for (int nx = 1; nx <= p; ++nx) {
+      for (int ny = 1; nx * ny <= p; ++ny) {
+        if (p % (nx * ny) != 0) continue;
+        EXPECT_LE(area(d[0], d[1], d[2]), area(nx, ny, p / (nx * ny)) * (1 + 1e-12));
+      }
+    }
+  }
+  EXPECT_THROW(grid_dims(0, Vector3(1, 1, 1)), InvalidArgument);
+  EXPECT_THROW(grid_dims(2, Vector3(1, 0, 1)), InvalidArgument);
+}
+
+TEST(CartesianGrid, NeighboursAreTheSubdomainsWithinReachThroughPeriodicImagesToo) {
+  const CartesianGrid line(Box(Vector3(0, 0, 0), Vector3(4, 1, 1)), {4, 1, 1});
+  EXPECT_EQ(line.neighbours(0, 0.1), (std::vector<int>{1}));
+  EXPECT_EQ(line.neighbours(1, 0.1), (std::vector<int>{0, 2}));
+  EXPECT_EQ(line.neighbours(0, 1.5), (std::vector<int>{1, 2}));
+  const CartesianGrid ring(Box(Vector3(0, 0, 0), Vector3(4, 1, 1)), {4, 1, 1}, {true, false, false});
+  EXPECT_EQ(ring.neighbours(0, 0.1), (std::vector<int>{1, 3}));
+  const CartesianGrid one(Box(Vector3(0, 0, 0), Vector3(4, 1, 1)), {1, 1, 1}, {true, false, false});
+  EXPECT_EQ(one.neighbours(0, 0.1), (std::vector<int>{0}));  // its own image
+  const CartesianGrid square(Box(Vector3(0, 0, 0), Vector3(2, 2, 1)), {2, 2, 1});
+  EXPECT_EQ(square.neighbours(0, 0.0), (std::vector<int>{1, 2, 3}));  // the corner touches
+  EXPECT_THROW(CartesianGrid(Box(Vector3(0, 0, 0), Vector3(1, 1, 1)), {0, 1, 1}), InvalidArgument);
+  EXPECT_THROW(CartesianGrid(Box(Vector3(0, 0, 0), Vector3(1, 0, 1)), {1, 1, 1}), InvalidArgument);
+  EXPECT_THROW(line.cell_of(4), InvalidArgument);
+}
+
+}  // namespace
+}  // namespace grbd::parallel
