@@ -12,7 +12,10 @@
 #include <vector>
 
 #include "grbd/core/error.hpp"
+#include "grbd/core/hash.hpp"
+#include "grbd/parallel/exchange.hpp"
 #include "grbd/parallel/mpi.hpp"
+#include "grbd/timestep/body_system.hpp"
 
 namespace grbd::parallel {
 namespace {
@@ -104,6 +107,182 @@ TEST(Communicator, ExchangeWithNeighboursOnARing) {
   }
   const int outside[] = {p};
   EXPECT_THROW(world->exchange(outside, std::span(send).first(1), received), InvalidArgument);
+}
+
+// ---- Body exchange: migration, borders, forward -------------------------------------------
+
+// A number in [−1, 1) from a body's id and a round: the same on every process, whatever P.
+double noise(std::uint64_t id, int round, int axis) {
+  const std::uint64_t h = mix64(mix64(id * 0x9e3779b97f4a7c15ULL + static_cast<std::uint64_t>(round)) +
+                                static_cast<std::uint64_t>(axis));
+  return static_cast<double>(h >> 11) * 0x1.0p-52 - 1.0;
+}
+
+timestep::BodyRecord bead(std::uint64_t id, const Box& domain) {
+  timestep::BodyRecord r;
+  r.id = id;
+  const double radius = 0.01 + 0.01 * (noise(id, -1, 3) + 1.0);  // 0.01 … 0.03 m
+  r.shape = collision::Sphere{radius};
+  r.inertia = {1.0, Vector3::Constant(0.4 * radius * radius)};
+  const Vector3 u(noise(id, -1, 0), noise(id, -1, 1), noise(id, -1, 2));
+  const Vector3 c = domain.min() + (0.5 * (u.array() + 1.0)).matrix().cwiseProduct(domain.sizes());
+  r.state.q << c, 1.0, 0.0, 0.0, 0.0;
+  r.state.u << noise(id, -2, 0), noise(id, -2, 1), 0.0, 0.0, 0.0, noise(id, -2, 2);
+  return r;
+}
+
+// Every owned body of every process: id, bounding radius, q, u.
+struct Everyone {
+  std::vector<std::uint64_t> ids;
+  std::vector<double> radii;
+  std::vector<body::State> states;
+};
+
+Everyone gather(const timestep::BodySystem& system) {
+  std::vector<std::byte> mine;
+  for (std::size_t i = 0; i < system.owned_count(); ++i) {
+    const std::uint64_t id = system.ids()[i];
+    const double r = system.bounding_radii()[i];
+    const body::State& x = system.states()[i];
+    const auto put = [&](const void* p, std::size_t n) {
+      const auto* b = static_cast<const std::byte*>(p);
+      mine.insert(mine.end(), b, b + n);
+    };
+    put(&id, 8);
+    put(&r, 8);
+    put(x.q.data(), 56);
+    put(x.u.data(), 48);
+  }
+  std::vector<std::vector<std::byte>> all;
+  world->all_gather(mine, all);
+  Everyone e;
+  for (const auto& bytes : all) {
+    for (std::size_t at = 0; at + 120 <= bytes.size(); at += 120) {
+      std::uint64_t id;
+      double r;
+      body::State x;
+      std::memcpy(&id, bytes.data() + at, 8);
+      std::memcpy(&r, bytes.data() + at + 8, 8);
+      std::memcpy(x.q.data(), bytes.data() + at + 16, 56);
+      std::memcpy(x.u.data(), bytes.data() + at + 72, 48);
+      e.ids.push_back(id);
+      e.radii.push_back(r);
+      e.states.push_back(x);
+    }
+  }
+  return e;
+}
+
+// Every ghost this process must hold, from everyone's bodies, without the exchange's shortcuts:
+// each body, each periodic shift, tested against this subdomain.
+void expect_exact_ghosts(const timestep::BodySystem& system, const CartesianGrid& grid,
+                         double margin, const Everyone& all) {
+  const int me = world->rank();
+  const Box mine = grid.subdomain(me);
+  const Vector3 L = grid.domain().sizes();
+  std::size_t expected = 0;
+  for (std::size_t b = 0; b < all.ids.size(); ++b) {
+    const Vector3 c = all.states[b].q.head<3>();
+    for (int sz = -1; sz <= 1; ++sz) {
+      for (int sy = -1; sy <= 1; ++sy) {
+        for (int sx = -1; sx <= 1; ++sx) {
+          const std::array<int, 3> s{sx, sy, sz};
+          bool allowed = true;
+          for (int d = 0; d < 3; ++d) allowed = allowed && (s[d] == 0 || grid.periodic()[d]);
+          if (!allowed) continue;
+          const bool plain = sx == 0 && sy == 0 && sz == 0;
+          if (plain && grid.owner_of(c) == me) continue;
+          const Vector3 shift(sx * L.x(), sy * L.y(), sz * L.z());
+          if (!overlaps(c + shift, all.radii[b] + margin, mine)) continue;
+          ++expected;
+          const std::size_t row = system.ghost_index_of(all.ids[b], image_code(s));
+          ASSERT_NE(row, timestep::BodySystem::npos)
+              << "rank " << me << ": no ghost of body " << all.ids[b] << " image " << image_code(s);
+          Vector3 p = c;
+          p += shift;
+          EXPECT_EQ(system.states()[row].q.head<3>(), p);
+          EXPECT_EQ(system.states()[row].q.tail<4>(), all.states[b].q.tail<4>());
+          EXPECT_EQ(system.states()[row].u, all.states[b].u);
+        }
+      }
+    }
+  }
+  EXPECT_EQ(system.ghost_count(), expected) << "rank " << me;
+}
+
+TEST(BodyExchange, MigrationAndBordersKeepEveryBodyOnceAndEveryGhostExact) {
+  const int p = world->size();
+  const int me = world->rank();
+  const Box domain(Vector3(0.0, 0.0, 0.0), Vector3(1.0, 0.6, 0.4));
+  const CartesianGrid grid(domain, grid_dims(p, domain.sizes()), {true, true, false});
+  const double margin = 0.02;
+  const std::uint64_t n = 400;
+  timestep::BodySystem system;
+  for (std::uint64_t id = 1; id <= n; ++id) {
+    const timestep::BodyRecord r = bead(id, domain);
+    if (grid.owner_of(r.state.q.head<3>()) == me) system.add(r);
+  }
+  BodyExchange exchange(*world, grid, margin, 0.03);
+  std::uint64_t migrated = 0;
+  for (int round = 0; round < 25; ++round) {
+    // Every body moves by up to 2 cm along x and y (periodic) and 1 cm along z (kept inside).
+    for (std::size_t i = 0; i < system.owned_count(); ++i) {
+      body::State& x = system.states()[i];
+      const std::uint64_t id = system.ids()[i];
+      x.q.x() += 0.02 * noise(id, round, 0);
+      x.q.y() += 0.02 * noise(id, round, 1);
+      x.q.z() = std::clamp(x.q.z() + 0.01 * noise(id, round, 2), 0.05, 0.35);
+    }
+    migrated += exchange.migrate(system);
+    exchange.borders(system);
+    const Everyone all = gather(system);
+    // No body lost or duplicated: the ids are 1 … n, each once, each with its owner.
+    std::vector<std::uint64_t> ids = all.ids;
+    std::sort(ids.begin(), ids.end());
+    ASSERT_EQ(ids.size(), n);
+    for (std::uint64_t k = 0; k < n; ++k) ASSERT_EQ(ids[k], k + 1);
+    for (std::size_t i = 0; i < system.owned_count(); ++i) {
+      const Vector3 c = system.states()[i].q.head<3>();
+      ASSERT_EQ(grid.owner_of(c), me);
+      ASSERT_TRUE(c.x() >= 0.0 && c.x() < 1.0 && c.y() >= 0.0 && c.y() < 0.6);  // wrapped
+    }
+    expect_exact_ghosts(system, grid, margin, all);
+    if (HasFatalFailure()) return;
+    // Forward: the owners move a little (no migration) and change their velocities; the ghosts
+    // follow, bit for bit.
+    for (std::size_t i = 0; i < system.owned_count(); ++i) {
+      system.states()[i].q.z() += 1e-4;
+      system.states()[i].u[3] = static_cast<double>(round);
+    }
+    exchange.forward(system);
+    expect_exact_ghosts(system, grid, margin, gather(system));
+  }
+  std::vector<std::uint64_t> total{migrated};
+  world->sum(total);
+  if (p > 1) {
+    EXPECT_GT(total[0], 100u);  // bodies did cross between processes
+  }
+  // forward() after a change of layout is refused.
+  if (system.owned_count() > 0) {
+    const std::size_t first[] = {0};
+    system.remove(first);
+    EXPECT_THROW(exchange.forward(system), InvalidArgument);
+  }
+}
+
+TEST(BodyExchange, ImageCodesRoundTrip) {
+  for (int sz = -1; sz <= 1; ++sz) {
+    for (int sy = -1; sy <= 1; ++sy) {
+      for (int sx = -1; sx <= 1; ++sx) {
+        const std::array<int, 3> s{sx, sy, sz};
+        EXPECT_EQ(image_shift(image_code(s)), s);
+      }
+    }
+  }
+  EXPECT_EQ(image_code({0, 0, 0}), 0u);
+  EXPECT_THROW(image_shift(14), InvalidArgument);
+  EXPECT_THROW(image_shift(28), InvalidArgument);
+  EXPECT_THROW(image_code({2, 0, 0}), InvalidArgument);
 }
 
 }  // namespace

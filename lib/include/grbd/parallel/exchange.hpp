@@ -1,0 +1,76 @@
+#pragma once
+/// \file
+/// \brief Body communication among processes (chapter 8): migration of owned bodies to the process
+/// that owns their centre, borders (ghost copies for every process a body reaches, periodic images
+/// included) and the forward exchange of the owners' states to their ghosts — LAMMPS' exchange,
+/// borders and forward communication, Nützi's migration and update.
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include "grbd/core/communicator.hpp"
+#include "grbd/parallel/decomposition.hpp"
+#include "grbd/timestep/body_system.hpp"
+
+namespace grbd::parallel {
+
+/// The image code of a periodic shift s ∈ {−1, 0, 1}³ (in periods along each axis): 0 for no shift,
+/// else 1 + (s_x + 1) + 3 (s_y + 1) + 9 (s_z + 1). A ghost's (global id, image) is its identity.
+std::uint32_t image_code(const std::array<int, 3>& shift);
+/// The shift of an image code (the inverse of image_code()); throws InvalidArgument for a code
+/// that is not one.
+std::array<int, 3> image_shift(std::uint32_t code);
+
+/// The exchanges of bodies between the processes of a CartesianGrid. Every process of the
+/// communicator calls each operation at the same point (they are collective).
+///
+/// A body of bounding radius r needs a ghost on every process whose subdomain (or a periodic image
+/// of it) it reaches within r + `margin`: its contacts up to the margin, and its motion until the
+/// ghosts are rebuilt, stay there. The driver rebuilds (migrate(), then borders()) when some body
+/// has moved more than half the skin, and calls forward() at every other step.
+class BodyExchange {
+ public:
+  /// `margin`: contact margin plus skin [m], ≥ 0 and finite; `max_radius`: the largest bounding
+  /// radius a body of the run can have [m] (from the scene), > 0: the neighbours are found for
+  /// their sum. Throws InvalidArgument for a grid whose size is not the communicator's.
+  BodyExchange(const Communicator& comm, const CartesianGrid& grid, double margin,
+               double max_radius);
+
+  /// Migration: clears the ghosts, wraps the owned bodies' centres along the periodic axes, and
+  /// sends every owned body whose owner is another process to it (removed here, added there, with
+  /// its state). Throws grbd::Error naming the body when its new owner is not a neighbour (it
+  /// crossed a whole subdomain since the last migration: the time step or the skin is too large).
+  /// Returns the number of bodies this process sent.
+  std::size_t migrate(timestep::BodySystem& system);
+
+  /// Borders: clears the ghosts and gives every process a ghost of each owned body that reaches
+  /// its subdomain (within its bounding radius + margin), through periodic images too (a
+  /// process can hold images of its own bodies); remembers what went where for forward().
+  /// Returns the number of ghosts this process received.
+  std::size_t borders(timestep::BodySystem& system);
+
+  /// Forward: the owners' current states to their ghosts (positions shifted by each ghost's
+  /// image), bit for bit. The system's layout must be the one borders() left (throws
+  /// InvalidArgument otherwise: bodies were added, removed or reordered since).
+  void forward(timestep::BodySystem& system);
+
+  /// The processes this one exchanges with (CartesianGrid::neighbours for max_radius + margin).
+  const std::vector<int>& neighbours() const { return neighbours_; }
+
+ private:
+  struct Sent {
+    std::vector<std::size_t> rows;  // owned rows, in message order
+  };
+  const Communicator& comm_;
+  const CartesianGrid& grid_;
+  double margin_;
+  std::vector<int> neighbours_;
+  std::vector<Sent> sent_;                           // per neighbour, from the last borders()
+  std::vector<std::size_t> ghost_start_, ghost_count_;  // per neighbour: rows received
+  std::uint64_t layout_ = ~std::uint64_t{0};           // the system's layout after borders()
+  std::vector<std::vector<std::byte>> out_, in_;       // message buffers, kept
+};
+
+}  // namespace grbd::parallel

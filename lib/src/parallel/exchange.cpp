@@ -1,0 +1,229 @@
+/// \file
+/// \brief Body communication among processes: migration, borders, forward.
+
+#include "grbd/parallel/exchange.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <string>
+
+#include "grbd/core/checks.hpp"
+#include "grbd/core/error.hpp"
+#include "grbd/timestep/body_record.hpp"
+
+namespace grbd::parallel {
+
+namespace {
+
+// One ghost in a borders() message: the packed body and its image code.
+constexpr std::size_t kGhostBytes = timestep::kPackedBodyBytes + 8;
+// One state in a forward() message: q and u.
+constexpr std::size_t kStateBytes = 13 * sizeof(double);
+
+void append(std::vector<std::byte>& out, const void* data, std::size_t n) {
+  const auto* bytes = static_cast<const std::byte*>(data);
+  out.insert(out.end(), bytes, bytes + n);
+}
+
+void append_body(std::vector<std::byte>& out, const timestep::BodyRecord& record) {
+  timestep::PackedBody packed;
+  timestep::pack(record, packed);
+  append(out, packed.data(), packed.size());
+}
+
+timestep::BodyRecord body_at(const std::vector<std::byte>& in, std::size_t offset) {
+  return timestep::unpack(
+      std::span<const std::byte, timestep::kPackedBodyBytes>(in.data() + offset,
+                                                             timestep::kPackedBodyBytes));
+}
+
+// The shifts in periods that the grid's periodic axes allow: (0, 0, 0) first.
+std::vector<std::array<int, 3>> allowed_shifts(const CartesianGrid& grid) {
+  std::vector<std::array<int, 3>> shifts{{0, 0, 0}};
+  const auto& p = grid.periodic();
+  for (int sz = -1; sz <= 1; ++sz) {
+    for (int sy = -1; sy <= 1; ++sy) {
+      for (int sx = -1; sx <= 1; ++sx) {
+        if ((sx && !p[0]) || (sy && !p[1]) || (sz && !p[2]) || (!sx && !sy && !sz)) continue;
+        shifts.push_back({sx, sy, sz});
+      }
+    }
+  }
+  return shifts;
+}
+
+Vector3 shift_vector(const CartesianGrid& grid, const std::array<int, 3>& s) {
+  const Vector3 L = grid.domain().sizes();
+  return Vector3(s[0] * L.x(), s[1] * L.y(), s[2] * L.z());
+}
+
+}  // namespace
+
+std::uint32_t image_code(const std::array<int, 3>& s) {
+  for (const int c : s) {
+    if (c < -1 || c > 1) {
+      throw InvalidArgument("image_code: expected shifts of −1, 0 or 1 period, found " +
+                            std::to_string(c));
+    }
+  }
+  if (s[0] == 0 && s[1] == 0 && s[2] == 0) return 0;
+  return static_cast<std::uint32_t>(1 + (s[0] + 1) + 3 * (s[1] + 1) + 9 * (s[2] + 1));
+}
+
+std::array<int, 3> image_shift(std::uint32_t code) {
+  if (code == 0) return {0, 0, 0};
+  if (code > 27 || code == 14) {
+    throw InvalidArgument("image_shift: " + std::to_string(code) + " is not an image code");
+  }
+  const int k = static_cast<int>(code) - 1;
+  return {k % 3 - 1, (k / 3) % 3 - 1, k / 9 - 1};
+}
+
+BodyExchange::BodyExchange(const Communicator& comm, const CartesianGrid& grid, double margin,
+                           double max_radius)
+    : comm_(comm), grid_(grid), margin_(margin) {
+  if (grid.size() != comm.size()) {
+    throw InvalidArgument("BodyExchange: the grid has " + std::to_string(grid.size()) +
+                          " subdomains for " + std::to_string(comm.size()) + " processes");
+  }
+  if (!(margin >= 0.0) || !std::isfinite(margin)) {
+    throw InvalidArgument("BodyExchange: expected a finite margin >= 0, found " +
+                          format_number(margin));
+  }
+  require_positive_finite("BodyExchange", "max_radius", max_radius);
+  neighbours_ = grid.neighbours(comm.rank(), max_radius + margin);
+  const std::size_t m = neighbours_.size();
+  sent_.resize(m);
+  ghost_start_.assign(m, 0);
+  ghost_count_.assign(m, 0);
+  out_.resize(m);
+}
+
+// [migrate]
+std::size_t BodyExchange::migrate(timestep::BodySystem& system) {
+  system.clear_ghosts();
+  layout_ = ~std::uint64_t{0};
+  const int me = comm_.rank();
+  for (auto& message : out_) message.clear();
+  std::vector<std::size_t> leaving;
+  const auto states = system.states();
+  for (std::size_t i = 0; i < system.owned_count(); ++i) {
+    Vector3 c = states[i].q.head<3>();
+    const Vector3 wrapped = grid_.wrap(c);
+    if (wrapped != c) states[i].q.head<3>() = wrapped;  // crossed a periodic boundary
+    const int owner = grid_.owner_of(wrapped);
+    if (owner == me) continue;
+    const auto k = std::lower_bound(neighbours_.begin(), neighbours_.end(), owner);
+    if (k == neighbours_.end() || *k != owner) {
+      throw Error("BodyExchange::migrate: body " + std::to_string(system.ids()[i]) +
+                  " moved from the subdomain of process " + std::to_string(me) +
+                  " into that of process " + std::to_string(owner) +
+                  ", which is not a neighbour: it crossed a whole subdomain since the last "
+                  "migration (shorten the time step or the skin)");
+    }
+    append_body(out_[static_cast<std::size_t>(k - neighbours_.begin())], system.record(i));
+    leaving.push_back(i);
+  }
+  system.remove(leaving);
+  comm_.exchange(neighbours_, out_, in_);
+  for (const std::vector<std::byte>& message : in_) {
+    for (std::size_t at = 0; at + timestep::kPackedBodyBytes <= message.size();
+         at += timestep::kPackedBodyBytes) {
+      system.add(body_at(message, at));
+    }
+  }
+  return leaving.size();
+}
+// [migrate]
+
+// [borders]
+std::size_t BodyExchange::borders(timestep::BodySystem& system) {
+  system.clear_ghosts();
+  const int me = comm_.rank();
+  const Box mine = grid_.subdomain(me);
+  const std::vector<std::array<int, 3>> shifts = allowed_shifts(grid_);
+  for (std::size_t k = 0; k < neighbours_.size(); ++k) {
+    out_[k].clear();
+    sent_[k].rows.clear();
+  }
+  const auto states = system.states();
+  const auto radii = system.bounding_radii();
+  for (std::size_t i = 0; i < system.owned_count(); ++i) {
+    const Vector3 c = states[i].q.head<3>();
+    const double reach = radii[i] + margin_;
+    // Deep inside its own subdomain, a body reaches no other and no image: the common case
+    // (with a relative 10⁻¹² to spare, so that no rounding skips a body overlaps() would send).
+    const Vector3 inside = (c - mine.min()).cwiseMin(mine.max() - c);
+    if (inside.minCoeff() > reach * (1.0 + 1e-12)) continue;
+    for (std::size_t k = 0; k < neighbours_.size(); ++k) {
+      const Box box = grid_.subdomain(neighbours_[k]);
+      for (const std::array<int, 3>& s : shifts) {
+        const bool plain = s == std::array<int, 3>{0, 0, 0};
+        if (plain && neighbours_[k] == me) continue;  // the body itself
+        if (!overlaps(c + shift_vector(grid_, s), reach, box)) continue;
+        append_body(out_[k], system.record(i));
+        const std::uint64_t code = image_code(s);
+        append(out_[k], &code, sizeof code);
+        sent_[k].rows.push_back(i);
+      }
+    }
+  }
+  comm_.exchange(neighbours_, out_, in_);
+  std::size_t received = 0;
+  for (std::size_t k = 0; k < neighbours_.size(); ++k) {
+    ghost_start_[k] = system.size();
+    const std::vector<std::byte>& message = in_[k];
+    for (std::size_t at = 0; at + kGhostBytes <= message.size(); at += kGhostBytes) {
+      std::uint64_t code = 0;
+      std::memcpy(&code, message.data() + at + timestep::kPackedBodyBytes, sizeof code);
+      const auto image = static_cast<std::uint32_t>(code);
+      system.add_ghost(body_at(message, at), shift_vector(grid_, image_shift(image)), image);
+    }
+    ghost_count_[k] = system.size() - ghost_start_[k];
+    received += ghost_count_[k];
+  }
+  layout_ = system.layout_version();
+  return received;
+}
+// [borders]
+
+// [forward]
+void BodyExchange::forward(timestep::BodySystem& system) {
+  if (system.layout_version() != layout_) {
+    throw InvalidArgument("BodyExchange::forward: the bodies were added, removed or reordered "
+                          "since borders(): rebuild the ghosts (migrate, borders) first");
+  }
+  const auto states = system.states();
+  for (std::size_t k = 0; k < neighbours_.size(); ++k) {
+    std::vector<std::byte>& message = out_[k];
+    message.resize(sent_[k].rows.size() * kStateBytes);
+    std::byte* at = message.data();
+    for (const std::size_t i : sent_[k].rows) {
+      std::memcpy(at, states[i].q.data(), 7 * sizeof(double));
+      std::memcpy(at + 7 * sizeof(double), states[i].u.data(), 6 * sizeof(double));
+      at += kStateBytes;
+    }
+  }
+  comm_.exchange(neighbours_, out_, in_);
+  const auto images = system.images();
+  for (std::size_t k = 0; k < neighbours_.size(); ++k) {
+    if (in_[k].size() != ghost_count_[k] * kStateBytes) {
+      throw Error("BodyExchange::forward: process " + std::to_string(neighbours_[k]) + " sent " +
+                  std::to_string(in_[k].size() / kStateBytes) + " states for " +
+                  std::to_string(ghost_count_[k]) + " ghosts: the processes disagree on the "
+                  "ghosts (a borders() call missing on some process)");
+    }
+    const std::byte* at = in_[k].data();
+    for (std::size_t g = 0; g < ghost_count_[k]; ++g, at += kStateBytes) {
+      const std::size_t row = ghost_start_[k] + g;
+      body::State& x = states[row];
+      std::memcpy(x.q.data(), at, 7 * sizeof(double));
+      std::memcpy(x.u.data(), at + 7 * sizeof(double), 6 * sizeof(double));
+      x.q.head<3>() += shift_vector(grid_, image_shift(images[row]));
+    }
+  }
+}
+// [forward]
+
+}  // namespace grbd::parallel
