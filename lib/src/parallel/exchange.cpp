@@ -82,7 +82,7 @@ std::array<int, 3> image_shift(std::uint32_t code) {
 
 BodyExchange::BodyExchange(const Communicator& comm, const CartesianGrid& grid, double margin,
                            double max_radius)
-    : comm_(comm), grid_(grid), margin_(margin) {
+    : comm_(comm), grid_(grid), margin_(margin), max_radius_(max_radius) {
   if (grid.size() != comm.size()) {
     throw InvalidArgument("BodyExchange: the grid has " + std::to_string(grid.size()) +
                           " subdomains for " + std::to_string(comm.size()) + " processes");
@@ -92,7 +92,7 @@ BodyExchange::BodyExchange(const Communicator& comm, const CartesianGrid& grid, 
                           format_number(margin));
   }
   require_positive_finite("BodyExchange", "max_radius", max_radius);
-  neighbours_ = grid.neighbours(comm.rank(), max_radius + margin);
+  neighbours_ = grid.neighbours(comm.rank(), 2.0 * max_radius + margin);
   const std::size_t m = neighbours_.size();
   sent_.resize(m);
   ghost_start_.assign(m, 0);
@@ -151,7 +151,7 @@ std::size_t BodyExchange::borders(timestep::BodySystem& system) {
   const auto radii = system.bounding_radii();
   for (std::size_t i = 0; i < system.owned_count(); ++i) {
     const Vector3 c = states[i].q.head<3>();
-    const double reach = radii[i] + margin_;
+    const double reach = radii[i] + max_radius_ + margin_;
     // Deep inside its own subdomain, a body reaches no other and no image: the common case
     // (with a relative 10⁻¹² to spare, so that no rounding skips a body overlaps() would send).
     const Vector3 inside = (c - mine.min()).cwiseMin(mine.max() - c);
@@ -188,12 +188,21 @@ std::size_t BodyExchange::borders(timestep::BodySystem& system) {
 }
 // [borders]
 
+namespace {
+
+void require_layout(const timestep::BodySystem& system, std::uint64_t layout, const char* what) {
+  if (system.layout_version() != layout) {
+    throw InvalidArgument(std::string("BodyExchange::") + what + ": the bodies were added, "
+                          "removed or reordered since borders(): rebuild the ghosts (migrate, "
+                          "borders) first");
+  }
+}
+
+}  // namespace
+
 // [forward]
 void BodyExchange::forward(timestep::BodySystem& system) {
-  if (system.layout_version() != layout_) {
-    throw InvalidArgument("BodyExchange::forward: the bodies were added, removed or reordered "
-                          "since borders(): rebuild the ghosts (migrate, borders) first");
-  }
+  require_layout(system, layout_, "forward");
   const auto states = system.states();
   for (std::size_t k = 0; k < neighbours_.size(); ++k) {
     std::vector<std::byte>& message = out_[k];
@@ -225,5 +234,57 @@ void BodyExchange::forward(timestep::BodySystem& system) {
   }
 }
 // [forward]
+
+void BodyExchange::forward_values(const timestep::BodySystem& system, std::span<double> values,
+                                  int width) {
+  require_layout(system, layout_, "forward_values");
+  const auto w = static_cast<std::size_t>(width);
+  for (std::size_t k = 0; k < neighbours_.size(); ++k) {
+    std::vector<std::byte>& message = out_[k];
+    message.resize(sent_[k].rows.size() * w * sizeof(double));
+    std::byte* at = message.data();
+    for (const std::size_t i : sent_[k].rows) {
+      std::memcpy(at, values.data() + i * w, w * sizeof(double));
+      at += w * sizeof(double);
+    }
+  }
+  comm_.exchange(neighbours_, out_, in_);
+  for (std::size_t k = 0; k < neighbours_.size(); ++k) {
+    if (in_[k].size() != ghost_count_[k] * w * sizeof(double)) {
+      throw Error("BodyExchange::forward_values: process " + std::to_string(neighbours_[k]) +
+                  " sent values for another number of ghosts");
+    }
+    std::memcpy(values.data() + ghost_start_[k] * w, in_[k].data(), in_[k].size());
+  }
+}
+
+// [reverse]
+void BodyExchange::reverse_add(const timestep::BodySystem& system, std::span<double> values,
+                               int width) {
+  require_layout(system, layout_, "reverse_add");
+  const auto w = static_cast<std::size_t>(width);
+  for (std::size_t k = 0; k < neighbours_.size(); ++k) {
+    const std::size_t bytes = ghost_count_[k] * w * sizeof(double);
+    out_[k].resize(bytes);
+    std::memcpy(out_[k].data(), values.data() + ghost_start_[k] * w, bytes);
+  }
+  comm_.exchange(neighbours_, out_, in_);
+  for (std::size_t k = 0; k < neighbours_.size(); ++k) {
+    if (in_[k].size() != sent_[k].rows.size() * w * sizeof(double)) {
+      throw Error("BodyExchange::reverse_add: process " + std::to_string(neighbours_[k]) +
+                  " sent values for another number of ghosts");
+    }
+    const std::byte* from = in_[k].data();
+    for (std::size_t j = 0; j < sent_[k].rows.size(); ++j) {
+      double* to = values.data() + sent_[k].rows[j] * w;
+      for (std::size_t d = 0; d < w; ++d, from += sizeof(double)) {
+        double x;
+        std::memcpy(&x, from, sizeof x);
+        to[d] += x;
+      }
+    }
+  }
+}
+// [reverse]
 
 }  // namespace grbd::parallel

@@ -144,13 +144,15 @@ void ContactDetector::detect(const BodySystem& system, const StaticGeometry& sta
       if (!(g.g_N <= margin)) continue;
       DetectedContact c;
       c.geometry = g;
-      const auto side = [&](const Side& s, collision::BodyIndex& body, MaterialId& material) {
+      const auto side = [&](const Side& s, collision::BodyIndex& body, std::int32_t& row,
+                            MaterialId& material) {
         body = s.is_body && system.dynamic(s.index) ? static_cast<collision::BodyIndex>(s.index)
                                                     : collision::kStatic;
+        row = s.is_body ? static_cast<std::int32_t>(s.index) : -1;
         material = s.is_body ? materials[s.index] : objects[s.index].material;
       };
-      side(x, c.body_a, c.material_a);
-      side(y, c.body_b, c.material_b);
+      side(x, c.body_a, c.row_a, c.material_a);
+      side(y, c.body_b, c.row_b, c.material_b);
       contacts.push_back(c);
       keys.push_back({id_of(x), id_of(y), g.feature_a, g.feature_b});
     }

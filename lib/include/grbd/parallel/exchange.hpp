@@ -8,6 +8,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include "grbd/core/communicator.hpp"
@@ -27,14 +28,16 @@ std::array<int, 3> image_shift(std::uint32_t code);
 /// communicator calls each operation at the same point (they are collective).
 ///
 /// A body of bounding radius r needs a ghost on every process whose subdomain (or a periodic image
-/// of it) it reaches within r + `margin`: its contacts up to the margin, and its motion until the
-/// ghosts are rebuilt, stay there. The driver rebuilds (migrate(), then borders()) when some body
-/// has moved more than half the skin, and calls forward() at every other step.
+/// of it) it reaches within r + r_max + `margin`: every body it can touch, whose centre may lie
+/// anywhere in that subdomain, then finds it there, up to the margin and for as long as the
+/// ghosts are not rebuilt. The driver rebuilds (migrate(), then borders()) when some body has moved
+/// more than half the skin, and calls forward() at every other step.
 class BodyExchange {
  public:
   /// `margin`: contact margin plus skin [m], ≥ 0 and finite; `max_radius`: the largest bounding
-  /// radius a body of the run can have [m] (from the scene), > 0: the neighbours are found for
-  /// their sum. Throws InvalidArgument for a grid whose size is not the communicator's.
+  /// radius r_max a body of the run can have [m] (from the scene), > 0: the neighbours are the
+  /// subdomains within 2 r_max + margin. Throws InvalidArgument for a grid whose size is not the
+  /// communicator's.
   BodyExchange(const Communicator& comm, const CartesianGrid& grid, double margin,
                double max_radius);
 
@@ -46,10 +49,19 @@ class BodyExchange {
   std::size_t migrate(timestep::BodySystem& system);
 
   /// Borders: clears the ghosts and gives every process a ghost of each owned body that reaches
-  /// its subdomain (within its bounding radius + margin), through periodic images too (a
+  /// its subdomain (within its bounding radius + r_max + margin), through periodic images too (a
   /// process can hold images of its own bodies); remembers what went where for forward().
   /// Returns the number of ghosts this process received.
   std::size_t borders(timestep::BodySystem& system);
+
+  /// Per-body values from the owners to their ghosts: `values` holds `width` doubles per row of
+  /// the system; the rows of the ghosts are overwritten with their owners' values. The layout must
+  /// be the one borders() left, as for forward().
+  void forward_values(const timestep::BodySystem& system, std::span<double> values, int width);
+  /// Per-body values from the ghosts back to their owners, added: each owned row's values get the
+  /// values of its ghosts on every process, in the order of the neighbours and of the last
+  /// borders() (a reverse communication). Ghost rows are left as they are.
+  void reverse_add(const timestep::BodySystem& system, std::span<double> values, int width);
 
   /// Forward: the owners' current states to their ghosts (positions shifted by each ghost's
   /// image), bit for bit. The system's layout must be the one borders() left (throws
@@ -66,6 +78,7 @@ class BodyExchange {
   const Communicator& comm_;
   const CartesianGrid& grid_;
   double margin_;
+  double max_radius_;
   std::vector<int> neighbours_;
   std::vector<Sent> sent_;                           // per neighbour, from the last borders()
   std::vector<std::size_t> ghost_start_, ghost_count_;  // per neighbour: rows received

@@ -33,12 +33,16 @@ struct ContactKey {
 
 /// A contact as detection finds it: the two sides as the contact problem sees them, their
 /// materials, and the geometry at the detected states (normal from b towards a, gap, the two
-/// closest points, features). 112 bytes: no tangent basis, no lever arms in body frames (the
-/// stepper forms the compact problem of contact::CompactProblem from it).
+/// closest points, features), and the rows of the two sides in the BodySystem. 120 bytes: no
+/// tangent basis, no lever arms in body frames (the stepper forms the compact problem of
+/// contact::CompactProblem from it).
 struct DetectedContact {
   /// a dynamic body's local index, or collision::kStatic (a static object or a fixed body)
   collision::BodyIndex body_a = collision::kStatic;
   collision::BodyIndex body_b = collision::kStatic;  ///< as body_a, for side b
+  /// The row of side a in the BodySystem, fixed bodies included; −1 for a static object.
+  std::int32_t row_a = -1;
+  std::int32_t row_b = -1;  ///< as row_a, for side b
   MaterialId material_a = 0;                         ///< material of side a
   MaterialId material_b = 0;                         ///< material of side b
   collision::ContactGeometry geometry;               ///< n, g_N, points, features

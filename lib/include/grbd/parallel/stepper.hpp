@@ -1,0 +1,89 @@
+#pragma once
+/// \file
+/// \brief Chapter 6's step on many processes (chapter 8): every process steps its own bodies with
+/// a MoreauStepper whose hooks do the parallel work — ghosts refreshed before the step, each
+/// contact kept by one process, split bodies by mass splitting, the solver's verdict and the
+/// report made global.
+
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <vector>
+
+#include "grbd/core/communicator.hpp"
+#include "grbd/parallel/decomposition.hpp"
+#include "grbd/parallel/exchange.hpp"
+#include "grbd/timestep/stepper.hpp"
+
+namespace grbd::parallel {
+
+/// What the parallel step adds to StepSettings.
+struct ParallelSettings {
+  /// The largest bounding radius a body of the run can have [m] > 0 (from the scene): ghosts reach
+  /// r + r_max + margin.
+  double max_radius = 0.0;
+};
+
+/// Moreau's step for the bodies of this process, in lock step with the other processes of the
+/// communicator. Construction and step() are collective.
+///
+/// Before each step the ghosts are refreshed (BodyExchange::forward), or rebuilt (migrate, then
+/// borders) when some body of any process has moved more than half the skin
+/// (StepSettings::skin; 0 rebuilds at every step). In the step:
+/// - after detection, a contact is kept only by the process that owns its side a (a static side a:
+///   side b), so that each contact is solved exactly once;
+/// - a body whose ghost copies take part in kept contacts on other processes is split: each of its
+///   m copies (the owner's and the active ghosts) carries the mass M/m, and after every sweep the
+///   copies' velocities are replaced by their mean, the velocity all copies share at the solution
+///   (Tonge, Benevolenski, Voroshilov 2012);
+/// - the solver stops when every process has converged, and the report sums contacts and
+///   energies over the processes (in rank order) and takes the largest residual, penetration and
+///   iteration count.
+/// With one process and no periodic axis there are no ghosts, and the step is the serial step.
+class ParallelStepper {
+ public:
+  /// Throws InvalidArgument when settings.tolerance_radius is 0 (the active set of a parallel run
+  /// must not depend on the bodies a process holds: take it from the scene), when max_radius is not
+  /// positive, or when the grid does not fit the communicator.
+  ParallelStepper(const Communicator& comm, const CartesianGrid& grid, timestep::BodySystem& system,
+                  const timestep::StaticGeometry& statics, const timestep::MaterialTable& materials,
+                  timestep::StepSettings settings, ParallelSettings parallel);
+  ~ParallelStepper();
+  ParallelStepper(const ParallelStepper&) = delete;
+  ParallelStepper& operator=(const ParallelStepper&) = delete;
+
+  /// One step of every process; the report is the global one (the same on every process).
+  timestep::StepReport step();
+
+  /// The serial stepper underneath (its contacts, percussions and warm starts are this process's).
+  const timestep::MoreauStepper& stepper() const { return *stepper_; }
+  /// How often the ghosts were rebuilt.
+  std::uint64_t rebuilds() const { return rebuilds_; }
+  /// Bodies owned here that were split in the last step (their copies elsewhere had contacts).
+  std::size_t split_bodies() const { return split_owned_; }
+
+ private:
+  bool rebuild_due() const;
+  void select_contacts(const timestep::BodySystem& system,
+                       std::vector<timestep::DetectedContact>& contacts,
+                       std::vector<timestep::ContactKey>& keys);
+  void split_masses(contact::CompactProblem& problem);
+  void average_split_velocities(std::span<Vector6> u);
+  void reduce(timestep::StepReport& report) const;
+
+  const Communicator& comm_;
+  timestep::BodySystem& system_;
+  double skin_;
+  BodyExchange exchange_;
+  std::unique_ptr<timestep::MoreauStepper> stepper_;
+  std::vector<Vector3> reference_;   // owned centres at the last rebuild
+  std::vector<double> copies_;       // per row: the number of copies of its body (1: not split)
+  std::vector<double> active_;       // per row: 1 for a ghost in a kept contact
+  std::vector<double> velocities_;   // per row: 6 doubles for the averaging
+  std::uint64_t rebuilds_ = 0;
+  std::size_t split_owned_ = 0;
+  bool any_split_ = false;
+};
+
+}  // namespace grbd::parallel

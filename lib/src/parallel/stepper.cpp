@@ -1,0 +1,184 @@
+/// \file
+/// \brief Chapter 6's step on many processes: ghosts, one process per contact, mass splitting, a
+/// global verdict and report.
+
+#include "grbd/parallel/stepper.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include "grbd/core/checks.hpp"
+#include "grbd/core/error.hpp"
+
+namespace grbd::parallel {
+
+ParallelStepper::ParallelStepper(const Communicator& comm, const CartesianGrid& grid,
+                                 timestep::BodySystem& system,
+                                 const timestep::StaticGeometry& statics,
+                                 const timestep::MaterialTable& materials,
+                                 timestep::StepSettings settings, ParallelSettings parallel)
+    : comm_(comm),
+      system_(system),
+      skin_(settings.skin),
+      exchange_(comm, grid, settings.contact_tolerance * settings.tolerance_radius + settings.skin,
+                parallel.max_radius) {
+  if (!(settings.tolerance_radius > 0.0)) {
+    throw InvalidArgument("ParallelStepper: expected the tolerance radius of the scene "
+                          "(StepSettings::tolerance_radius > 0): the active set of a parallel run "
+                          "must not depend on the bodies a process holds");
+  }
+  timestep::StepHooks hooks;
+  hooks.after_detection = [this](const timestep::BodySystem& s,
+                                 std::vector<timestep::DetectedContact>& contacts,
+                                 std::vector<timestep::ContactKey>& keys) {
+    select_contacts(s, contacts, keys);
+  };
+  hooks.after_assembly = [this](contact::CompactProblem& problem, contact::ContactSolution&) {
+    split_masses(problem);
+  };
+  hooks.solver.velocities_between_sweeps = [this](int, std::span<Vector6> u) {
+    average_split_velocities(u);
+  };
+  hooks.solver.global_status = [this](contact::IterationStatus local) {
+    std::vector<double> status{static_cast<double>(local)};
+    comm_.max(status);
+    return static_cast<contact::IterationStatus>(static_cast<int>(status[0]));
+  };
+  hooks.reduce_report = [this](timestep::StepReport& report) { reduce(report); };
+  stepper_ = std::make_unique<timestep::MoreauStepper>(system, statics, materials, settings,
+                                                       std::move(hooks));
+}
+
+ParallelStepper::~ParallelStepper() = default;
+
+// [parallel step]
+timestep::StepReport ParallelStepper::step() {
+  if (rebuild_due()) {
+    exchange_.migrate(system_);
+    exchange_.borders(system_);
+    reference_.resize(system_.owned_count());
+    for (std::size_t i = 0; i < reference_.size(); ++i) {
+      reference_[i] = system_.states()[i].q.head<3>();
+    }
+    ++rebuilds_;
+  } else {
+    exchange_.forward(system_);
+  }
+  return stepper_->step();
+}
+// [parallel step]
+
+// Some body of some process has moved more than half the skin since the last rebuild (with a
+// relative 10⁻¹² to spare, as the candidate list).
+bool ParallelStepper::rebuild_due() const {
+  if (rebuilds_ == 0) return true;
+  double largest = 0.0;
+  for (std::size_t i = 0; i < reference_.size(); ++i) {
+    largest = std::max(largest, (system_.states()[i].q.head<3>() - reference_[i]).squaredNorm());
+  }
+  std::vector<double> global{largest};
+  comm_.max(global);
+  const double half = 0.5 * skin_ * (1.0 - 1e-12);
+  return global[0] > half * half;
+}
+
+// [select contacts]
+void ParallelStepper::select_contacts(const timestep::BodySystem& system,
+                                      std::vector<timestep::DetectedContact>& contacts,
+                                      std::vector<timestep::ContactKey>& keys) {
+  // Each contact on one process: the owner of its side a (of side b when a is a static object).
+  std::size_t kept = 0;
+  for (std::size_t k = 0; k < contacts.size(); ++k) {
+    const timestep::DetectedContact& c = contacts[k];
+    const int row = c.row_a >= 0 ? c.row_a : c.row_b;
+    if (row < 0 || !system.owned(static_cast<std::size_t>(row))) continue;
+    if (kept != k) {
+      contacts[kept] = contacts[k];
+      keys[kept] = keys[k];
+    }
+    ++kept;
+  }
+  contacts.resize(kept);
+  keys.resize(kept);
+  // The copies of each body: its owner's, and each ghost that takes part in a kept contact.
+  const std::size_t n = system.size();
+  copies_.assign(n, 0.0);
+  for (const timestep::DetectedContact& c : contacts) {
+    for (const int row : {c.row_a, c.row_b}) {
+      if (row >= 0 && !system.owned(static_cast<std::size_t>(row)) &&
+          system.dynamic(static_cast<std::size_t>(row))) {
+        copies_[static_cast<std::size_t>(row)] = 1.0;
+      }
+    }
+  }
+  active_.assign(copies_.begin(), copies_.end());
+  exchange_.reverse_add(system, copies_, 1);
+  split_owned_ = 0;
+  for (std::size_t i = 0; i < system.owned_count(); ++i) {
+    copies_[i] += 1.0;
+    if (copies_[i] > 1.0) ++split_owned_;
+  }
+  exchange_.forward_values(system, copies_, 1);
+  any_split_ = comm_.any(split_owned_ > 0);
+}
+// [select contacts]
+
+// [split masses]
+void ParallelStepper::split_masses(contact::CompactProblem& problem) {
+  // A copy of a body with m copies carries the mass M/m: its inverse mass is m M⁻¹. Its load is
+  // scaled alike, so its free velocity u + Δt M⁻¹ h does not change.
+  for (std::size_t i = 0; i < copies_.size(); ++i) {
+    if (copies_[i] > 1.0) {
+      problem.M_inv[i].inv_m *= copies_[i];
+      problem.M_inv[i].I_Theta_inv *= copies_[i];
+    }
+  }
+}
+// [split masses]
+
+// [average]
+void ParallelStepper::average_split_velocities(std::span<Vector6> u) {
+  if (!any_split_) return;  // the same decision on every process: no exchange at all
+  const std::size_t n = system_.size();
+  velocities_.assign(6 * n, 0.0);
+  for (std::size_t r = system_.owned_count(); r < n; ++r) {
+    if (active_[r] > 0.0) Eigen::Map<Vector6>(velocities_.data() + 6 * r) = u[r];
+  }
+  exchange_.reverse_add(system_, velocities_, 6);
+  // The copies share one mass M/m each: the mass-weighted mean is the plain mean, for the
+  // angular velocity too (the same orientation, so the same world-frame inertia).
+  for (std::size_t i = 0; i < system_.owned_count(); ++i) {
+    if (copies_[i] > 1.0) {
+      const Vector6 mean = (u[i] + Eigen::Map<const Vector6>(velocities_.data() + 6 * i)) /
+                           copies_[i];
+      u[i] = mean;
+      Eigen::Map<Vector6>(velocities_.data() + 6 * i) = mean;
+    }
+  }
+  exchange_.forward_values(system_, velocities_, 6);
+  for (std::size_t r = system_.owned_count(); r < n; ++r) {
+    if (copies_[r] > 1.0) u[r] = Eigen::Map<const Vector6>(velocities_.data() + 6 * r);
+  }
+}
+// [average]
+
+void ParallelStepper::reduce(timestep::StepReport& report) const {
+  std::vector<double> sums{static_cast<double>(report.contacts),
+                           static_cast<double>(report.warm_started), report.kinetic_energy,
+                           report.potential_energy};
+  comm_.sum(sums);
+  std::vector<double> maxima{static_cast<double>(report.iterations), report.residual,
+                             report.max_penetration, report.converged ? 0.0 : 1.0};
+  comm_.max(maxima);
+  report.contacts = static_cast<std::size_t>(sums[0]);
+  report.warm_started = static_cast<std::size_t>(sums[1]);
+  report.kinetic_energy = sums[2];
+  report.potential_energy = sums[3];
+  report.iterations = static_cast<int>(maxima[0]);
+  report.residual = maxima[1];
+  report.max_penetration = maxima[2];
+  report.converged = maxima[3] == 0.0;
+}
+
+}  // namespace grbd::parallel
