@@ -1,6 +1,6 @@
 /// \file
-/// \brief The Cartesian decomposition of the domain; chapter 8 exercises: the owner of a position
-/// and the overlap of a body with a subdomain.
+/// \brief The Cartesian decomposition of the domain; chapter 8 exercises: the owner of a position,
+/// the overlap of a body with a subdomain, and the process that solves a contact.
 
 #include "grbd/parallel/decomposition.hpp"
 
@@ -168,6 +168,15 @@ bool overlaps(const Vector3& centre, double reach, const Box& box) {
   const Vector3 closest = centre.cwiseMax(box.min()).cwiseMin(box.max());
   return (closest - centre).squaredNorm() <= reach * reach;
   // END EXERCISE 8.2
+}
+
+bool solves_contact(const timestep::BodySystem& system, const timestep::DetectedContact& c) {
+  // BEGIN EXERCISE 8.3: which process solves a contact?
+  // Hint: the side that decides is side a (row_a), unless side a is a static object (row −1):
+  //   then side b. A process solves the contact when it owns that side (BodySystem::owned).
+  const int row = c.row_a >= 0 ? c.row_a : c.row_b;
+  return row >= 0 && system.owned(static_cast<std::size_t>(row));
+  // END EXERCISE 8.3
 }
 
 }  // namespace grbd::parallel

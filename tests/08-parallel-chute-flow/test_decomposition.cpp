@@ -5,12 +5,14 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <map>
 #include <cmath>
 #include <random>
 #include <vector>
 
 #include "grbd/core/error.hpp"
 #include "grbd/parallel/decomposition.hpp"
+#include "grbd/timestep/contacts.hpp"
 
 namespace grbd::parallel {
 namespace {
@@ -133,6 +135,72 @@ TEST(CartesianGrid, NeighboursAreTheSubdomainsWithinReachThroughPeriodicImagesTo
   EXPECT_THROW(CartesianGrid(Box(Vector3(0, 0, 0), Vector3(1, 1, 1)), {0, 1, 1}), InvalidArgument);
   EXPECT_THROW(CartesianGrid(Box(Vector3(0, 0, 0), Vector3(1, 0, 1)), {1, 1, 1}), InvalidArgument);
   EXPECT_THROW(line.cell_of(4), InvalidArgument);
+}
+
+// Exercise 8.3: split a dense random packing among the six subdomains of a 3 × 2 × 1 grid; each
+// part holds its owned bodies and, as ghosts, every body that reaches its subdomain within
+// r + r_max + margin (what BodyExchange::borders sends). Each part detects its contacts and keeps
+// those it solves: together the parts keep every contact of the whole system exactly once, with
+// the same geometry bit for bit.
+TEST(Exercise8_3, EveryContactIsSolvedByExactlyOneProcess) {
+  const Box domain(Vector3(0, 0, 0), Vector3(0.3, 0.2, 0.1));
+  const CartesianGrid grid(domain, {3, 2, 1});
+  std::mt19937_64 rng(13);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  timestep::BodySystem full;
+  timestep::StaticGeometry statics;
+  timestep::StaticObject floor;
+  floor.id = 0;
+  floor.shape = collision::HalfSpace{Vector3::UnitZ(), 0.0};
+  statics.add(floor);
+  const double r_max = 0.012;
+  for (timestep::GlobalId id = 1; id <= 900; ++id) {
+    timestep::BodyRecord b;
+    b.id = id;
+    const double r = 0.008 + 0.004 * u(rng);
+    b.shape = collision::Sphere{r};
+    b.inertia = {1.0, Vector3::Constant(0.4 * r * r)};
+    b.flags = id % 50 == 0 ? 0 : timestep::kDynamic;  // a few fixed beads
+    b.state.q << 0.3 * u(rng), 0.2 * u(rng), r * (0.9 + 6.0 * u(rng)), 1.0, 0.0, 0.0, 0.0;
+    b.state.u.setZero();
+    full.add(b);
+  }
+  const double margin = 1e-3;
+  timestep::ContactDetector detector;
+  std::vector<timestep::DetectedContact> all;
+  std::vector<timestep::ContactKey> all_keys;
+  detector.detect(full, statics, margin, all, all_keys);
+  ASSERT_GT(all.size(), 500u);
+  std::map<timestep::ContactKey, int> solved;
+  for (int p = 0; p < grid.size(); ++p) {
+    const Box box = grid.subdomain(p);
+    timestep::BodySystem part;
+    for (std::size_t i = 0; i < full.size(); ++i) {
+      if (grid.owner_of(full.states()[i].q.head<3>()) == p) part.add(full.record(i));
+    }
+    for (std::size_t i = 0; i < full.size(); ++i) {
+      const Vector3 c = full.states()[i].q.head<3>();
+      if (grid.owner_of(c) != p && overlaps(c, full.bounding_radii()[i] + r_max + margin, box)) {
+        part.add_ghost(full.record(i));
+      }
+    }
+    std::vector<timestep::DetectedContact> found;
+    std::vector<timestep::ContactKey> keys;
+    detector.detect(part, statics, margin, found, keys);
+    for (std::size_t k = 0; k < found.size(); ++k) {
+      if (!solves_contact(part, found[k])) continue;
+      ++solved[keys[k]];
+      const auto it = std::find(all_keys.begin(), all_keys.end(), keys[k]);
+      ASSERT_NE(it, all_keys.end());
+      const timestep::DetectedContact& reference = all[static_cast<std::size_t>(it - all_keys.begin())];
+      EXPECT_EQ(found[k].geometry.g_N, reference.geometry.g_N);
+      EXPECT_EQ(found[k].geometry.I_n, reference.geometry.I_n);
+    }
+  }
+  EXPECT_EQ(solved.size(), all_keys.size());
+  for (const auto& [key, times] : solved) {
+    EXPECT_EQ(times, 1) << "contact " << key.a << "–" << key.b;
+  }
 }
 
 }  // namespace

@@ -90,9 +90,7 @@ void ParallelStepper::select_contacts(const timestep::BodySystem& system,
   // Each contact on one process: the owner of its side a (of side b when a is a static object).
   std::size_t kept = 0;
   for (std::size_t k = 0; k < contacts.size(); ++k) {
-    const timestep::DetectedContact& c = contacts[k];
-    const int row = c.row_a >= 0 ? c.row_a : c.row_b;
-    if (row < 0 || !system.owned(static_cast<std::size_t>(row))) continue;
+    if (!solves_contact(system, contacts[k])) continue;
     if (kept != k) {
       contacts[kept] = contacts[k];
       keys[kept] = keys[k];

@@ -8,6 +8,8 @@
 #include <vector>
 
 #include "grbd/core/types.hpp"
+#include "grbd/timestep/body_system.hpp"
+#include "grbd/timestep/contacts.hpp"
 
 namespace grbd::parallel {
 
@@ -79,5 +81,13 @@ class CartesianGrid {
 /// r + m. Exercise 8.2.
 bool overlaps(const Vector3& centre, double reach, const Box& box);
 // [overlaps]
+
+// [solves contact]
+/// True when this process solves the contact: it owns the contact's side a (side b when side a is
+/// a static object). Side a is the first side in the canonical order of keys, decided by kinds and
+/// global ids, so every process that finds the contact decides alike, and exactly one of them —
+/// the owner of that side — keeps it. Exercise 8.3.
+bool solves_contact(const timestep::BodySystem& system, const timestep::DetectedContact& contact);
+// [solves contact]
 
 }  // namespace grbd::parallel
