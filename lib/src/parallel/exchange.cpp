@@ -107,6 +107,7 @@ std::size_t BodyExchange::migrate(timestep::BodySystem& system) {
   const int me = comm_.rank();
   for (auto& message : out_) message.clear();
   std::vector<std::size_t> leaving;
+  leaving_.clear();
   const auto states = system.states();
   for (std::size_t i = 0; i < system.owned_count(); ++i) {
     Vector3 c = states[i].q.head<3>();
@@ -124,6 +125,7 @@ std::size_t BodyExchange::migrate(timestep::BodySystem& system) {
     }
     append_body(out_[static_cast<std::size_t>(k - neighbours_.begin())], system.record(i));
     leaving.push_back(i);
+    leaving_.emplace_back(system.ids()[i], static_cast<std::size_t>(k - neighbours_.begin()));
   }
   system.remove(leaving);
   comm_.exchange(neighbours_, out_, in_);
@@ -136,6 +138,43 @@ std::size_t BodyExchange::migrate(timestep::BodySystem& system) {
   return leaving.size();
 }
 // [migrate]
+
+std::size_t BodyExchange::migrate(timestep::BodySystem& system, timestep::WarmStartTable& warm) {
+  const std::size_t sent = migrate(system);
+  // The contacts a leaving body decides go with it: key (4 words) and percussion (3 doubles).
+  std::sort(leaving_.begin(), leaving_.end());
+  for (auto& message : out_) message.clear();
+  std::vector<timestep::ContactKey> kept_keys;
+  std::vector<Vector3> kept_lambda;
+  const auto keys = warm.keys();
+  const auto lambda = warm.lambda();
+  for (std::size_t k = 0; k < keys.size(); ++k) {
+    const timestep::GlobalId decider = (keys[k].a & timestep::kStaticTag) ? keys[k].b : keys[k].a;
+    const auto it = std::lower_bound(leaving_.begin(), leaving_.end(),
+                                     std::pair<timestep::GlobalId, std::size_t>{decider, 0});
+    if (it != leaving_.end() && it->first == decider) {
+      append(out_[it->second], &keys[k], sizeof(timestep::ContactKey));
+      append(out_[it->second], lambda[k].data(), 3 * sizeof(double));
+    } else {
+      kept_keys.push_back(keys[k]);
+      kept_lambda.push_back(lambda[k]);
+    }
+  }
+  comm_.exchange(neighbours_, out_, in_);
+  constexpr std::size_t kEntry = sizeof(timestep::ContactKey) + 3 * sizeof(double);
+  for (const std::vector<std::byte>& message : in_) {
+    for (std::size_t at = 0; at + kEntry <= message.size(); at += kEntry) {
+      timestep::ContactKey key;
+      Vector3 l;
+      std::memcpy(&key, message.data() + at, sizeof key);
+      std::memcpy(l.data(), message.data() + at + sizeof key, 3 * sizeof(double));
+      kept_keys.push_back(key);
+      kept_lambda.push_back(l);
+    }
+  }
+  warm.store(kept_keys, kept_lambda);
+  return sent;
+}
 
 // [borders]
 std::size_t BodyExchange::borders(timestep::BodySystem& system) {

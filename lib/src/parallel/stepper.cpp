@@ -55,7 +55,7 @@ ParallelStepper::~ParallelStepper() = default;
 // [parallel step]
 timestep::StepReport ParallelStepper::step() {
   if (rebuild_due()) {
-    exchange_.migrate(system_);
+    exchange_.migrate(system_, stepper_->warm_starts());
     exchange_.borders(system_);
     reference_.resize(system_.owned_count());
     for (std::size_t i = 0; i < reference_.size(); ++i) {

@@ -14,6 +14,7 @@
 #include "grbd/core/communicator.hpp"
 #include "grbd/parallel/decomposition.hpp"
 #include "grbd/timestep/body_system.hpp"
+#include "grbd/timestep/contacts.hpp"
 
 namespace grbd::parallel {
 
@@ -47,6 +48,10 @@ class BodyExchange {
   /// crossed a whole subdomain since the last migration: the time step or the skin is too large).
   /// Returns the number of bodies this process sent.
   std::size_t migrate(timestep::BodySystem& system);
+  /// Migration with warm starts: as above, and the warm starts of the contacts a leaving body
+  /// decides (its side a, or its side b against a static side a: the contacts its owner solves)
+  /// go with it into the new owner's table, so that its contacts stay warm-started.
+  std::size_t migrate(timestep::BodySystem& system, timestep::WarmStartTable& warm);
 
   /// Borders: clears the ghosts and gives every process a ghost of each owned body that reaches
   /// its subdomain (within its bounding radius + r_max + margin), through periodic images too (a
@@ -84,6 +89,7 @@ class BodyExchange {
   std::vector<std::size_t> ghost_start_, ghost_count_;  // per neighbour: rows received
   std::uint64_t layout_ = ~std::uint64_t{0};           // the system's layout after borders()
   std::vector<std::vector<std::byte>> out_, in_;       // message buffers, kept
+  std::vector<std::pair<timestep::GlobalId, std::size_t>> leaving_;  // id, neighbour (migrate)
 };
 
 }  // namespace grbd::parallel
