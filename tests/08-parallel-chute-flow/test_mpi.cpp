@@ -470,6 +470,45 @@ TEST(ParallelStepper, WarmStartsTravelWithMigratingBodies) {
   EXPECT_NEAR(x[0], 0.06, 1e-9);
 }
 
+// Two equal spheres collide head on through the periodic boundary along x, with Newton's law and
+// ε_N = 1: their velocities swap (the closed form of a central elastic impact of equal masses), and
+// the momentum stays zero. On one process the contact is between a sphere and the periodic image
+// of the other, on several it also crosses processes.
+TEST(ParallelStepper, AnElasticImpactThroughThePeriodicBoundarySwapsTheVelocities) {
+  const int p = world->size();
+  const double r = 0.01;
+  const double L = 0.3;
+  const Box domain(Vector3(0.0, -0.05, -0.05), Vector3(L, 0.05, 0.05));
+  const CartesianGrid grid(domain, {p, 1, 1}, {true, false, false});
+  timestep::BodySystem mine;
+  const timestep::BodyRecord a = sphere(1, r, Vector3(0.02, 0.0, 0.0), Vector3(-1.0, 0.0, 0.0));
+  const timestep::BodyRecord b = sphere(2, r, Vector3(L - 0.0205, 0.0, 0.0), Vector3(1.0, 0.0, 0.0));
+  for (const timestep::BodyRecord& body : {a, b}) {
+    if (grid.owner_of(body.state.q.head<3>()) == world->rank()) mine.add(body);
+  }
+  const timestep::StaticGeometry statics;
+  timestep::MaterialTable materials;
+  materials.set_pair(materials.add("steel"), 0, {0.0, 1.0, 0.0});
+  timestep::StepSettings settings;
+  settings.dt = 1e-4;
+  settings.I_g.setZero();
+  settings.tolerance_radius = r;
+  settings.skin = 0.002;
+  settings.solver.abs_tol = 0.0;
+  settings.solver.rel_tol = 1e-12;
+  settings.solver.max_iterations = 5000;
+  ParallelStepper parallel(*world, grid, mine, statics, materials, settings, {r});
+  std::size_t contacts = 0;
+  for (int step = 0; step < 200; ++step) contacts += parallel.step().contacts;  // 20 ms
+  EXPECT_GT(contacts, 0u);
+  std::vector<double> v(2, 0.0);  // v_x of spheres 1 and 2, summed over the processes
+  for (std::size_t i = 0; i < mine.owned_count(); ++i) v[mine.ids()[i] - 1] = mine.states()[i].u[0];
+  world->sum(v);
+  EXPECT_NEAR(v[0], 1.0, 1e-9);
+  EXPECT_NEAR(v[1], -1.0, 1e-9);
+  EXPECT_NEAR(v[0] + v[1], 0.0, 1e-12);
+}
+
 }  // namespace
 }  // namespace grbd::parallel
 
@@ -478,6 +517,16 @@ TEST(ParallelStepper, WarmStartsTravelWithMigratingBodies) {
 int main(int argc, char** argv) {
   grbd::parallel::MpiEnvironment mpi(true);
   grbd::parallel::world = &mpi.world();
+  // --fail-on-last-rank: the last rank fails alone while the others wait in a collective call;
+  // abort_run must end them all with one message (the test ch08.mpi.abort checks it, with a
+  // timeout, so that a hang fails).
+  if (argc > 1 && std::string(argv[1]) == "--fail-on-last-rank") {
+    if (mpi.world().rank() == mpi.world().size() - 1) {
+      grbd::parallel::abort_run("a scene that fails on this rank only", 3);
+    }
+    mpi.world().barrier();
+    return 0;
+  }
   ::testing::InitGoogleTest(&argc, argv);
   if (mpi.world().rank() != 0) {
     ::testing::TestEventListeners& listeners = ::testing::UnitTest::GetInstance()->listeners();
