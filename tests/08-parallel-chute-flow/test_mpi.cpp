@@ -359,8 +359,13 @@ TEST(ParallelStepper, FreeFlightAcrossSubdomainsIsTheSerialRunBitForBit) {
 // subdomain per process along z): the percussion of the k-th contact from the top is k m g Δt, as
 // in the serial step, to the solver's tolerance; the spheres whose contacts another process solves
 // are split, and their copies end with one velocity.
-TEST(ParallelStepper, AColumnAcrossProcessBoundariesCarriesItsWeight) {
+// Averaging every sweep, and every third sweep (the copies then disagree in between, and the solver
+// stops only after an averaged sweep).
+class ColumnAcrossBoundaries : public ::testing::TestWithParam<int> {};
+
+TEST_P(ColumnAcrossBoundaries, CarriesItsWeight) {
   const int p = world->size();
+  const int average_every = GetParam();
   const double r = 0.01;
   const Box domain(Vector3(-0.05, -0.05, 0.0), Vector3(0.05, 0.05, 0.08));
   const CartesianGrid grid(domain, {1, 1, p});
@@ -378,14 +383,14 @@ TEST(ParallelStepper, AColumnAcrossProcessBoundariesCarriesItsWeight) {
   settings.solver.abs_tol = 0.0;
   settings.solver.rel_tol = 1e-13;
   settings.solver.max_iterations = 20000;
-  ParallelStepper parallel(*world, grid, mine, statics, materials, settings, {r});
+  ParallelStepper parallel(*world, grid, mine, statics, materials, settings, {r, average_every});
   timestep::StepReport report;
   for (int step = 0; step < 5; ++step) report = parallel.step();
   EXPECT_EQ(report.contacts, 4u);
   EXPECT_TRUE(report.converged);
   if (world->rank() == 0) {
-    std::printf("column of 4 spheres on %d process(es): %d iterations in the last step\n", p,
-                report.iterations);
+    std::printf("column of 4 spheres on %d process(es), averaged every %d sweeps: %d iterations "
+                "in the last step\n", p, average_every, report.iterations);
   }
   // Every process's kept contacts and percussions, gathered.
   std::vector<std::byte> bytes;
@@ -431,6 +436,8 @@ TEST(ParallelStepper, AColumnAcrossProcessBoundariesCarriesItsWeight) {
     EXPECT_GT(split[0], 0u);  // a sphere whose contact below is solved by another process
   }
 }
+
+INSTANTIATE_TEST_SUITE_P(ParallelStepper, ColumnAcrossBoundaries, ::testing::Values(1, 3));
 
 // A column of four frictionless spheres sliding across the boundaries between processes (one
 // subdomain per process along x): when its spheres migrate, the warm starts of the contacts they

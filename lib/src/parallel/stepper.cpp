@@ -21,8 +21,14 @@ ParallelStepper::ParallelStepper(const Communicator& comm, const CartesianGrid& 
     : comm_(comm),
       system_(system),
       skin_(settings.skin),
+      average_every_(parallel.average_every),
+      max_iterations_(settings.solver.max_iterations),
       exchange_(comm, grid, settings.contact_tolerance * settings.tolerance_radius + settings.skin,
                 parallel.max_radius) {
+  if (parallel.average_every < 1) {
+    throw InvalidArgument("ParallelStepper: expected average_every >= 1, found " +
+                          std::to_string(parallel.average_every));
+  }
   if (!(settings.tolerance_radius > 0.0)) {
     throw InvalidArgument("ParallelStepper: expected the tolerance radius of the scene "
                           "(StepSettings::tolerance_radius > 0): the active set of a parallel run "
@@ -37,10 +43,16 @@ ParallelStepper::ParallelStepper(const Communicator& comm, const CartesianGrid& 
   hooks.after_assembly = [this](contact::CompactProblem& problem, contact::ContactSolution&) {
     split_masses(problem);
   };
-  hooks.solver.velocities_between_sweeps = [this](int, std::span<Vector6> u) {
-    average_split_velocities(u);
+  hooks.solver.velocities_between_sweeps = [this](int k, std::span<Vector6> u) {
+    sweep_ = k;
+    if (k % average_every_ == 0 || k == max_iterations_) average_split_velocities(u);
   };
   hooks.solver.global_status = [this](contact::IterationStatus local) {
+    // Converged only after an averaged sweep, when the copies of every split body agree.
+    if (local == contact::IterationStatus::converged && any_split_ &&
+        sweep_ % average_every_ != 0) {
+      local = contact::IterationStatus::running;
+    }
     std::vector<double> status{static_cast<double>(local)};
     comm_.max(status);
     return static_cast<contact::IterationStatus>(static_cast<int>(status[0]));

@@ -23,6 +23,11 @@ struct ParallelSettings {
   /// The largest bounding radius a body of the run can have [m] > 0 (from the scene): ghosts reach
   /// r + r_max + margin.
   double max_radius = 0.0;
+  /// Average the split bodies' velocities after every this many sweeps (≥ 1). Averaging less often
+  /// saves messages and lets each process's sweeps go further on their own, at the price of copies
+  /// that disagree in between; the solver stops only after a sweep that was averaged, and the last
+  /// sweep it may do (max_iterations) is always averaged.
+  int average_every = 1;
 };
 
 /// Moreau's step for the bodies of this process, in lock step with the other processes of the
@@ -75,6 +80,9 @@ class ParallelStepper {
   const Communicator& comm_;
   timestep::BodySystem& system_;
   double skin_;
+  int average_every_;
+  int max_iterations_;
+  int sweep_ = 0;  // sweeps of the current solve (velocities_between_sweeps' k)
   BodyExchange exchange_;
   std::unique_ptr<timestep::MoreauStepper> stepper_;
   std::vector<Vector3> reference_;   // owned centres at the last rebuild
