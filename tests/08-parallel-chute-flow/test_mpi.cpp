@@ -27,7 +27,7 @@ const Communicator* world = nullptr;
 
 std::vector<std::byte> bytes_of(const std::string& text) {
   std::vector<std::byte> b(text.size());
-  std::memcpy(b.data(), text.data(), text.size());
+  if (!text.empty()) std::memcpy(b.data(), text.data(), text.size());
   return b;
 }
 

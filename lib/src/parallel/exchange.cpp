@@ -293,7 +293,9 @@ void BodyExchange::forward_values(const timestep::BodySystem& system, std::span<
       throw Error("BodyExchange::forward_values: process " + std::to_string(neighbours_[k]) +
                   " sent values for another number of ghosts");
     }
-    std::memcpy(values.data() + ghost_start_[k] * w, in_[k].data(), in_[k].size());
+    if (!in_[k].empty()) {  // memcpy from an empty vector's null data() is undefined
+      std::memcpy(values.data() + ghost_start_[k] * w, in_[k].data(), in_[k].size());
+    }
   }
 }
 
@@ -305,7 +307,7 @@ void BodyExchange::reverse_add(const timestep::BodySystem& system, std::span<dou
   for (std::size_t k = 0; k < neighbours_.size(); ++k) {
     const std::size_t bytes = ghost_count_[k] * w * sizeof(double);
     out_[k].resize(bytes);
-    std::memcpy(out_[k].data(), values.data() + ghost_start_[k] * w, bytes);
+    if (bytes > 0) std::memcpy(out_[k].data(), values.data() + ghost_start_[k] * w, bytes);
   }
   comm_.exchange(neighbours_, out_, in_);
   for (std::size_t k = 0; k < neighbours_.size(); ++k) {
