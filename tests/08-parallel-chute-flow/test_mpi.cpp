@@ -589,6 +589,48 @@ TEST(ParallelStepper, ASettlingPileEndsAsTheSerialPileDoes) {
   }
 }
 
+// A partition finer than the bodies: two stacked spheres of radius 1 cm in a domain 4 cm high, cut
+// into slices of 4/P cm (on three processes thinner than a sphere's radius and a half), so that a
+// sphere reaches into subdomains beyond the next one. The neighbours are found by distance, not
+// adjacency, and the percussions are still those of the serial step: m g Δt between the spheres,
+// 2 m g Δt on the floor.
+TEST(ParallelStepper, APartitionFinerThanTheBodiesStillGivesTheSerialPercussions) {
+  const int p = world->size();
+  const double r = 0.01;
+  const Box domain(Vector3(-0.02, -0.02, 0.0), Vector3(0.02, 0.02, 0.04));
+  const CartesianGrid grid(domain, {1, 1, p});
+  timestep::BodySystem mine;
+  for (std::uint64_t k = 0; k < 2; ++k) {
+    const Vector3 c(0.0, 0.0, r + 2.0 * r * static_cast<double>(k));
+    if (grid.owner_of(c) == world->rank()) mine.add(sphere(k + 1, r, c, Vector3::Zero()));
+  }
+  timestep::StaticGeometry statics;
+  timestep::StaticObject floor;
+  floor.shape = collision::HalfSpace{Vector3::UnitZ(), 0.0};
+  statics.add(floor);
+  const timestep::MaterialTable materials = glass();
+  timestep::StepSettings settings;
+  settings.dt = 1e-3;
+  settings.tolerance_radius = r;
+  settings.solver.abs_tol = 0.0;
+  settings.solver.rel_tol = 1e-13;
+  settings.solver.max_iterations = 20000;
+  ParallelStepper parallel(*world, grid, mine, statics, materials, settings, {r});
+  timestep::StepReport report;
+  for (int step = 0; step < 3; ++step) report = parallel.step();
+  EXPECT_EQ(report.contacts, 2u);
+  EXPECT_TRUE(report.converged);
+  const double m = 2500.0 * 4.0 / 3.0 * M_PI * r * r * r;
+  double total = 0.0;  // Λ_N summed over the processes' kept contacts: 3 m g Δt
+  for (const Vector3& l : parallel.stepper().percussions()) total += l[0];
+  std::vector<double> sum{total};
+  world->sum(sum);
+  EXPECT_NEAR(sum[0], 3.0 * m * 9.81 * 1e-3, 1e-9 * m * 9.81 * 1e-3);
+  for (std::size_t i = 0; i < mine.owned_count(); ++i) {
+    EXPECT_LT(mine.states()[i].u.norm(), 1e-12) << "sphere " << mine.ids()[i];
+  }
+}
+
 }  // namespace
 }  // namespace grbd::parallel
 
