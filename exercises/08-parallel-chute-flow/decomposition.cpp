@@ -75,6 +75,21 @@ CartesianGrid::CartesianGrid(const Box& domain, const std::array<int, 3>& dims,
                        : domain.min()[d] + (domain.max()[d] - domain.min()[d]) * i / dims[d];
     }
   }
+  shifts_.push_back({0, 0, 0});
+  for (int sz = -1; sz <= 1; ++sz) {
+    for (int sy = -1; sy <= 1; ++sy) {
+      for (int sx = -1; sx <= 1; ++sx) {
+        const bool none = sx == 0 && sy == 0 && sz == 0;
+        if (none || (sx && !periodic[0]) || (sy && !periodic[1]) || (sz && !periodic[2])) continue;
+        shifts_.push_back({sx, sy, sz});
+      }
+    }
+  }
+}
+
+Vector3 CartesianGrid::shift(const std::array<int, 3>& s) const {
+  const Vector3 L = domain_.sizes();
+  return Vector3(s[0] * L.x(), s[1] * L.y(), s[2] * L.z());
 }
 
 std::array<int, 3> CartesianGrid::cell_of(int rank) const {
@@ -127,26 +142,14 @@ std::vector<int> CartesianGrid::neighbours(int rank, double reach) const {
                           format_number(reach));
   }
   const Box mine = subdomain(rank);
-  const Vector3 length = domain_.sizes();
   std::vector<int> found;
   for (int other = 0; other < size(); ++other) {
     const Box box = subdomain(other);
-    // Its images: shifted by −L, 0, +L along each periodic axis.
-    for (int sx = -1; sx <= 1; ++sx) {
-      for (int sy = -1; sy <= 1; ++sy) {
-        for (int sz = -1; sz <= 1; ++sz) {
-          const std::array<int, 3> s{sx, sy, sz};
-          bool valid = true;
-          Vector3 shift = Vector3::Zero();
-          for (int d = 0; d < 3; ++d) {
-            if (s[d] != 0 && !periodic_[d]) valid = false;
-            shift[d] = s[d] * length[d];
-          }
-          if (!valid || (other == rank && s == std::array<int, 3>{0, 0, 0})) continue;
-          const Box image(box.min() + shift, box.max() + shift);
-          if (mine.exteriorDistance(image) <= reach) found.push_back(other);
-        }
-      }
+    // The subdomain and its images, shifted by −L, 0, +L along each periodic axis.
+    for (const std::array<int, 3>& s : shifts_) {
+      if (other == rank && s == shifts_.front()) continue;  // this subdomain itself
+      const Vector3 d = shift(s);
+      if (mine.exteriorDistance(Box(box.min() + d, box.max() + d)) <= reach) found.push_back(other);
     }
   }
   std::sort(found.begin(), found.end());

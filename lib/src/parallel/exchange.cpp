@@ -38,26 +38,6 @@ timestep::BodyRecord body_at(const std::vector<std::byte>& in, std::size_t offse
                                                              timestep::kPackedBodyBytes));
 }
 
-// The shifts in periods that the grid's periodic axes allow: (0, 0, 0) first.
-std::vector<std::array<int, 3>> allowed_shifts(const CartesianGrid& grid) {
-  std::vector<std::array<int, 3>> shifts{{0, 0, 0}};
-  const auto& p = grid.periodic();
-  for (int sz = -1; sz <= 1; ++sz) {
-    for (int sy = -1; sy <= 1; ++sy) {
-      for (int sx = -1; sx <= 1; ++sx) {
-        if ((sx && !p[0]) || (sy && !p[1]) || (sz && !p[2]) || (!sx && !sy && !sz)) continue;
-        shifts.push_back({sx, sy, sz});
-      }
-    }
-  }
-  return shifts;
-}
-
-Vector3 shift_vector(const CartesianGrid& grid, const std::array<int, 3>& s) {
-  const Vector3 L = grid.domain().sizes();
-  return Vector3(s[0] * L.x(), s[1] * L.y(), s[2] * L.z());
-}
-
 }  // namespace
 
 std::uint32_t image_code(const std::array<int, 3>& s) {
@@ -181,7 +161,6 @@ std::size_t BodyExchange::borders(timestep::BodySystem& system) {
   system.clear_ghosts();
   const int me = comm_.rank();
   const Box mine = grid_.subdomain(me);
-  const std::vector<std::array<int, 3>> shifts = allowed_shifts(grid_);
   for (std::size_t k = 0; k < neighbours_.size(); ++k) {
     out_[k].clear();
     sent_[k].rows.clear();
@@ -197,10 +176,10 @@ std::size_t BodyExchange::borders(timestep::BodySystem& system) {
     if (inside.minCoeff() > reach * (1.0 + 1e-12)) continue;
     for (std::size_t k = 0; k < neighbours_.size(); ++k) {
       const Box box = grid_.subdomain(neighbours_[k]);
-      for (const std::array<int, 3>& s : shifts) {
+      for (const std::array<int, 3>& s : grid_.image_shifts()) {
         const bool plain = s == std::array<int, 3>{0, 0, 0};
         if (plain && neighbours_[k] == me) continue;  // the body itself
-        if (!overlaps(c + shift_vector(grid_, s), reach, box)) continue;
+        if (!overlaps(c + grid_.shift(s), reach, box)) continue;
         append_body(out_[k], system.record(i));
         const std::uint64_t code = image_code(s);
         append(out_[k], &code, sizeof code);
@@ -217,7 +196,7 @@ std::size_t BodyExchange::borders(timestep::BodySystem& system) {
       std::uint64_t code = 0;
       std::memcpy(&code, message.data() + at + timestep::kPackedBodyBytes, sizeof code);
       const auto image = static_cast<std::uint32_t>(code);
-      system.add_ghost(body_at(message, at), shift_vector(grid_, image_shift(image)), image);
+      system.add_ghost(body_at(message, at), grid_.shift(image_shift(image)), image);
     }
     ghost_count_[k] = system.size() - ghost_start_[k];
     received += ghost_count_[k];
@@ -268,7 +247,7 @@ void BodyExchange::forward(timestep::BodySystem& system) {
       body::State& x = states[row];
       std::memcpy(x.q.data(), at, 7 * sizeof(double));
       std::memcpy(x.u.data(), at + 7 * sizeof(double), 6 * sizeof(double));
-      x.q.head<3>() += shift_vector(grid_, image_shift(images[row]));
+      x.q.head<3>() += grid_.shift(image_shift(images[row]));
     }
   }
 }

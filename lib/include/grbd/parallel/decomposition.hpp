@@ -52,6 +52,12 @@ class CartesianGrid {
   /// The box of a rank's subdomain.
   Box subdomain(int rank) const;
 
+  /// The shifts s ∈ {−1, 0, 1}³, in periods, that the periodic axes allow — the images of a
+  /// position or a subdomain — (0, 0, 0) first.
+  const std::vector<std::array<int, 3>>& image_shifts() const { return shifts_; }
+  /// The displacement of a shift in periods: s_d L_d along each axis [m].
+  Vector3 shift(const std::array<int, 3>& s) const;
+
   /// A position moved into the domain along the periodic axes (unchanged along the others).
   Vector3 wrap(const Vector3& position) const;
   // [owner of]
@@ -72,6 +78,7 @@ class CartesianGrid {
   std::array<int, 3> dims_;
   std::array<bool, 3> periodic_;
   std::array<std::vector<double>, 3> boundaries_;
+  std::vector<std::array<int, 3>> shifts_;
 };
 
 // [overlaps]
