@@ -100,17 +100,9 @@ void ParallelStepper::select_contacts(const timestep::BodySystem& system,
                                       std::vector<timestep::DetectedContact>& contacts,
                                       std::vector<timestep::ContactKey>& keys) {
   // Each contact on one process: the owner of its side a (of side b when a is a static object).
-  std::size_t kept = 0;
-  for (std::size_t k = 0; k < contacts.size(); ++k) {
-    if (!solves_contact(system, contacts[k])) continue;
-    if (kept != k) {
-      contacts[kept] = contacts[k];
-      keys[kept] = keys[k];
-    }
-    ++kept;
-  }
-  contacts.resize(kept);
-  keys.resize(kept);
+  timestep::keep_contacts_if(contacts, keys, [&](const timestep::DetectedContact& c) {
+    return solves_contact(system, c);
+  });
   // The copies of each body: its owner's, and each ghost that takes part in a kept contact.
   const std::size_t n = system.size();
   copies_.assign(n, 0.0);

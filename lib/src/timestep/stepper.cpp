@@ -277,17 +277,9 @@ void MoreauStepper::detect(const StepReport& report) {
     throw Error("MoreauStepper: step " + std::to_string(report.step) + " (t = " +
                 format_number(report.t) + " s): " + e.what());
   }
-  std::size_t active = 0;
-  for (std::size_t k = 0; k < contacts_.size(); ++k) {
-    if (!is_active(contacts_[k].geometry, tolerance_)) continue;
-    if (active != k) {
-      contacts_[active] = contacts_[k];
-      keys_[active] = keys_[k];
-    }
-    ++active;
-  }
-  contacts_.resize(active);
-  keys_.resize(active);
+  keep_contacts_if(contacts_, keys_, [this](const DetectedContact& c) {
+    return is_active(c.geometry, tolerance_);
+  });
   if (hooks_.after_detection) {
     hooks_.after_detection(system_, contacts_, keys_);
     if (keys_.size() != contacts_.size()) {

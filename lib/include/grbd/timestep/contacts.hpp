@@ -132,6 +132,24 @@ class WarmStartTable {
   std::vector<std::uint32_t> slots_;  // index + 1, 0 = empty
 };
 
+/// Keeps the contacts for which keep(contact) is true, and their keys with them, in their order,
+/// in place (the stepper's active set, a parallel run's contacts of this process).
+template <class Keep>
+void keep_contacts_if(std::vector<DetectedContact>& contacts, std::vector<ContactKey>& keys,
+                      Keep keep) {
+  std::size_t kept = 0;
+  for (std::size_t k = 0; k < contacts.size(); ++k) {
+    if (!keep(contacts[k])) continue;
+    if (kept != k) {
+      contacts[kept] = contacts[k];
+      keys[kept] = keys[k];
+    }
+    ++kept;
+  }
+  contacts.resize(kept);
+  keys.resize(kept);
+}
+
 /// A 64-bit hash of a key (splitmix64 finalisers of its four words).
 std::uint64_t hash(const ContactKey& key);
 
