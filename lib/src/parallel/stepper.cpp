@@ -81,8 +81,8 @@ timestep::StepReport ParallelStepper::step() {
 }
 // [parallel step]
 
-// Some body of some process has moved more than half the skin since the last rebuild (with a
-// relative 10⁻¹² to spare, as the candidate list).
+// Some body of some process has moved more than half the skin since the last rebuild (the rule of
+// the candidate list).
 bool ParallelStepper::rebuild_due() const {
   if (rebuilds_ == 0) return true;
   double largest = 0.0;
@@ -91,8 +91,7 @@ bool ParallelStepper::rebuild_due() const {
   }
   std::vector<double> global{largest};
   comm_.max(global);
-  const double half = 0.5 * skin_ * (1.0 - 1e-12);
-  return global[0] > half * half;
+  return global[0] > timestep::rebuild_distance_squared(skin_);
 }
 
 // [select contacts]

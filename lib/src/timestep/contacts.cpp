@@ -283,10 +283,7 @@ bool ContactDetector::list_is_valid(const BodySystem& system, double margin) con
       built_centres_.size() != centres_.size()) {
     return false;
   }
-  // Half the skin, less a relative 10⁻¹², so that rounding of the displacement never keeps a
-  // list one ulp too long.
-  const double half = 0.5 * skin_ * (1.0 - 1e-12);
-  const double limit = half * half;
+  const double limit = rebuild_distance_squared(skin_);
   for (std::size_t k = 0; k < centres_.size(); ++k) {
     if ((centres_[k] - built_centres_[k]).squaredNorm() > limit) return false;
   }

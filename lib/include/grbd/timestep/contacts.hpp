@@ -132,6 +132,14 @@ class WarmStartTable {
   std::vector<std::uint32_t> slots_;  // index + 1, 0 = empty
 };
 
+/// The squared displacement beyond which a candidate list, or ghosts, built with a skin s must be
+/// rebuilt: (s/2)², half the skin less a relative 10⁻¹², so that the rounding of a displacement
+/// never keeps one a step too long.
+inline double rebuild_distance_squared(double skin) {
+  const double half = 0.5 * skin * (1.0 - 1e-12);
+  return half * half;
+}
+
 /// Keeps the contacts for which keep(contact) is true, and their keys with them, in their order,
 /// in place (the stepper's active set, a parallel run's contacts of this process).
 template <class Keep>
