@@ -307,6 +307,36 @@ timestep::MaterialTable glass() {
   return table;
 }
 
+// A column of n spheres of radius r standing on the floor at (x, y), moving with v: the ones this
+// process owns.
+void add_column(timestep::BodySystem& mine, const CartesianGrid& grid, int n, double r,
+                const Vector3& base, const Vector3& v) {
+  for (std::uint64_t k = 0; k < static_cast<std::uint64_t>(n); ++k) {
+    const Vector3 c = base + Vector3(0.0, 0.0, r + 2.0 * r * static_cast<double>(k));
+    if (grid.owner_of(c) == world->rank()) mine.add(sphere(k + 1, r, c, v));
+  }
+}
+
+// The floor z = 0, static object 0.
+timestep::StaticGeometry floor_only() {
+  timestep::StaticGeometry statics;
+  timestep::StaticObject floor;
+  floor.shape = collision::HalfSpace{Vector3::UnitZ(), 0.0};
+  statics.add(floor);
+  return statics;
+}
+
+// A resting column's step: Δt = 1 ms, solved to a relative 10⁻¹³.
+timestep::StepSettings resting(double r) {
+  timestep::StepSettings settings;
+  settings.dt = 1e-3;
+  settings.tolerance_radius = r;
+  settings.solver.abs_tol = 0.0;
+  settings.solver.rel_tol = 1e-13;
+  settings.solver.max_iterations = 20000;
+  return settings;
+}
+
 // Free flight across subdomains: without contacts each body's motion is its own, and the parallel
 // step must reproduce the serial one bit for bit, wherever the body is owned.
 TEST(ParallelStepper, FreeFlightAcrossSubdomainsIsTheSerialRunBitForBit) {
@@ -370,20 +400,10 @@ TEST_P(ColumnAcrossBoundaries, CarriesItsWeight) {
   const Box domain(Vector3(-0.05, -0.05, 0.0), Vector3(0.05, 0.05, 0.08));
   const CartesianGrid grid(domain, {1, 1, p});
   timestep::BodySystem mine;
-  for (std::uint64_t k = 0; k < 4; ++k) {
-    const Vector3 c(0.0, 0.0, r + 2.0 * r * static_cast<double>(k));
-    if (grid.owner_of(c) == world->rank()) mine.add(sphere(k + 1, r, c, Vector3::Zero()));
-  }
-  timestep::StaticGeometry statics;
-  statics.add({0, collision::HalfSpace{Vector3::UnitZ(), 0.0}, {}, 0});
+  add_column(mine, grid, 4, r, Vector3::Zero(), Vector3::Zero());
+  const timestep::StaticGeometry statics = floor_only();
   const timestep::MaterialTable materials = glass();
-  timestep::StepSettings settings;
-  settings.dt = 1e-3;
-  settings.tolerance_radius = r;
-  settings.solver.abs_tol = 0.0;
-  settings.solver.rel_tol = 1e-13;
-  settings.solver.max_iterations = 20000;
-  ParallelStepper parallel(*world, grid, mine, statics, materials, settings, {r, average_every});
+  ParallelStepper parallel(*world, grid, mine, statics, materials, resting(r), {r, average_every});
   timestep::StepReport report;
   for (int step = 0; step < 5; ++step) report = parallel.step();
   EXPECT_EQ(report.contacts, 4u);
@@ -449,14 +469,8 @@ TEST(ParallelStepper, WarmStartsTravelWithMigratingBodies) {
   const Box domain(Vector3(-0.1, -0.05, 0.0), Vector3(0.1, 0.05, 0.1));
   const CartesianGrid grid(domain, {p, 1, 1});
   timestep::BodySystem mine;
-  for (std::uint64_t k = 0; k < 4; ++k) {
-    const Vector3 c(-0.09, 0.0, r + 2.0 * r * static_cast<double>(k));
-    if (grid.owner_of(c) == world->rank()) mine.add(sphere(k + 1, r, c, Vector3(1.0, 0.0, 0.0)));
-  }
-  timestep::StaticGeometry statics;
-  timestep::StaticObject floor;
-  floor.shape = collision::HalfSpace{Vector3::UnitZ(), 0.0};
-  statics.add(floor);
+  add_column(mine, grid, 4, r, Vector3(-0.09, 0.0, 0.0), Vector3(1.0, 0.0, 0.0));
+  const timestep::StaticGeometry statics = floor_only();
   timestep::MaterialTable materials;
   materials.set_pair(materials.add("ice"), 0, {0.0, 0.0, 0.0});
   timestep::StepSettings settings;
@@ -600,22 +614,10 @@ TEST(ParallelStepper, APartitionFinerThanTheBodiesStillGivesTheSerialPercussions
   const Box domain(Vector3(-0.02, -0.02, 0.0), Vector3(0.02, 0.02, 0.04));
   const CartesianGrid grid(domain, {1, 1, p});
   timestep::BodySystem mine;
-  for (std::uint64_t k = 0; k < 2; ++k) {
-    const Vector3 c(0.0, 0.0, r + 2.0 * r * static_cast<double>(k));
-    if (grid.owner_of(c) == world->rank()) mine.add(sphere(k + 1, r, c, Vector3::Zero()));
-  }
-  timestep::StaticGeometry statics;
-  timestep::StaticObject floor;
-  floor.shape = collision::HalfSpace{Vector3::UnitZ(), 0.0};
-  statics.add(floor);
+  add_column(mine, grid, 2, r, Vector3::Zero(), Vector3::Zero());
+  const timestep::StaticGeometry statics = floor_only();
   const timestep::MaterialTable materials = glass();
-  timestep::StepSettings settings;
-  settings.dt = 1e-3;
-  settings.tolerance_radius = r;
-  settings.solver.abs_tol = 0.0;
-  settings.solver.rel_tol = 1e-13;
-  settings.solver.max_iterations = 20000;
-  ParallelStepper parallel(*world, grid, mine, statics, materials, settings, {r});
+  ParallelStepper parallel(*world, grid, mine, statics, materials, resting(r), {r});
   timestep::StepReport report;
   for (int step = 0; step < 3; ++step) report = parallel.step();
   EXPECT_EQ(report.contacts, 2u);
