@@ -150,7 +150,7 @@ int main(int argc, char** argv) {
     Analysis a;
     const std::uint64_t last = scene.steps();
     options.on_step = [&](const grbd::scene::Simulation& sim,
-                          const grbd::timestep::StepReport& report) {
+                          const grbd::timestep::StepReport& report, std::uint64_t) {
       if (report.step == last) a = analyse(sim);
     };
     const grbd::io::RunResult result = grbd::io::run(scene, options);

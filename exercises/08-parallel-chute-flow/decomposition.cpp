@@ -114,6 +114,18 @@ Box CartesianGrid::subdomain(int rank) const {
   return Box(lo, hi);
 }
 
+Box CartesianGrid::owned_region(int rank) const {
+  Box box = subdomain(rank);
+  const std::array<int, 3> c = cell_of(rank);
+  constexpr double kInfinity = std::numeric_limits<double>::infinity();
+  for (int d = 0; d < 3; ++d) {
+    if (periodic_[d]) continue;
+    if (c[d] == 0) box.min()[d] = -kInfinity;
+    if (c[d] == dims_[d] - 1) box.max()[d] = kInfinity;
+  }
+  return box;
+}
+
 Vector3 CartesianGrid::wrap(const Vector3& position) const {
   Vector3 x = position;
   for (int d = 0; d < 3; ++d) {

@@ -43,6 +43,8 @@
 #include "grbd/contact/fclib_bench.hpp"
 #include "grbd/io/output.hpp"
 #include "grbd/io/run.hpp"
+#include "grbd/parallel/mpi.hpp"
+#include "grbd/parallel/run.hpp"
 #include "grbd/scene/scene.hpp"
 #include "grbd/scene/simulation.hpp"
 #include "grbd/version.hpp"
@@ -79,6 +81,12 @@ constexpr const char* kBenchExitCodes =
 
 volatile std::sig_atomic_t g_signal = 0;
 
+// Where the processes of a parallel run other than rank 0 write their messages.
+std::ostream& null_stream() {
+  static std::ostream none(nullptr);
+  return none;
+}
+
 extern "C" void on_signal(int signal) { g_signal = signal; }
 
 void install_handlers() {
@@ -107,7 +115,8 @@ class Progress {
  public:
   Progress(bool bar, std::uint64_t total) : bar_(bar), total_(total) {}
 
-  void update(const grbd::scene::Simulation& sim, const grbd::timestep::StepReport& report) {
+  void update(const grbd::scene::Simulation& sim, const grbd::timestep::StepReport& report,
+              std::uint64_t bodies) {
     const auto now = std::chrono::steady_clock::now();
     if (!started_) {
       started_ = true;
@@ -139,8 +148,8 @@ class Progress {
     line << std::fixed << std::setprecision(1) << std::setw(5) << 100.0 * fraction
          << "%  t = " << std::setprecision(4) << report.t << " / " << sim.scene().end_time
          << " s  step " << report.step << " / " << total_ << "  " << std::setprecision(1) << rate
-         << " steps/s  ETA " << clock_text(remaining) << "  bodies " << sim.system().size()
-         << "  contacts " << report.contacts << "  iterations " << report.iterations;
+         << " steps/s  ETA " << clock_text(remaining) << "  bodies " << bodies << "  contacts "
+         << report.contacts << "  iterations " << report.iterations;
     if (bar_) {
       constexpr int kWidth = 24;
       const int filled = static_cast<int>(fraction * kWidth);
@@ -170,11 +179,18 @@ int run_command(const std::string& scene_file, const std::optional<std::string>&
                 const std::optional<std::string>& checkpoint,
                 const std::optional<std::string>& restart, const std::optional<std::string>& end_time,
                 bool force, bool quiet, const std::string& progress) {
+  // Under mpirun: MPI for the run, rank 0 speaks for every process (one progress display, one
+  // summary, one message per error); each process exits with the same code.
+  const grbd::parallel::MpiEnvironment mpi;
+  const grbd::Communicator& world = mpi.world();
+  const bool speaker = world.rank() == 0;
+  if (!speaker) quiet = true;
+  std::ostream& errors = speaker ? std::cerr : null_stream();
   grbd::scene::Scene scene;
   try {
     scene = grbd::scene::load_scene(scene_file);
   } catch (const grbd::Error& e) {
-    std::cerr << "grbd run: " << e.what() << '\n';
+    errors << "grbd run: " << e.what() << '\n';
     return kExitInput;
   }
   if (end_time) {
@@ -183,7 +199,7 @@ int run_command(const std::string& scene_file, const std::optional<std::string>&
       grbd::scene::set_end_time(scene, grbd::scene::parse_real(*end_time, "--end-time"),
                                 "--end-time");
     } catch (const grbd::Error& e) {
-      std::cerr << "grbd run: " << e.what() << '\n';
+      errors << "grbd run: " << e.what() << '\n';
       return kExitUsage;
     }
   }
@@ -195,32 +211,35 @@ int run_command(const std::string& scene_file, const std::optional<std::string>&
   const bool bar = progress == "bar" || (progress == "auto" && isatty(STDERR_FILENO) != 0);
   Progress display(bar, scene.steps());
   bool started = false;  // an error after the first step is a failed run, not bad input
-  options.on_step = [&](const grbd::scene::Simulation& sim, const grbd::timestep::StepReport& r) {
+  options.on_step = [&](const grbd::scene::Simulation& sim, const grbd::timestep::StepReport& r,
+                        std::uint64_t bodies) {
     started = true;
-    if (!quiet) display.update(sim, r);
+    if (!quiet) display.update(sim, r, bodies);
   };
   options.on_warning = [&](const std::string& warning) {
-    std::cerr << "grbd run: warning: " << warning << '\n';
+    errors << "grbd run: warning: " << warning << '\n';
   };
   install_handlers();
   options.stop = &g_signal;
   grbd::io::RunResult result;
   try {
-    result = grbd::io::run(scene, options);
+    // One process takes exactly the serial path.
+    result = world.size() > 1 ? grbd::parallel::run(scene, options, world)
+                              : grbd::io::run(scene, options);
   } catch (const grbd::io::FileConflict& e) {
-    std::cerr << "grbd run: " << e.what() << '\n';
+    errors << "grbd run: " << e.what() << '\n';
     return kExitUsage;
   } catch (const grbd::scene::SceneError& e) {
     display.finish();
-    std::cerr << "grbd run: " << e.what() << '\n';
+    errors << "grbd run: " << e.what() << '\n';
     return started ? kExitFailed : kExitInput;
   } catch (const grbd::io::IoError& e) {
     display.finish();
-    std::cerr << "grbd run: " << e.what() << '\n';
+    errors << "grbd run: " << e.what() << '\n';
     return started ? kExitFailed : kExitInput;
   } catch (const grbd::Error& e) {
     display.finish();
-    std::cerr << "grbd run: the run failed: " << e.what() << '\n';
+    errors << "grbd run: the run failed: " << e.what() << '\n';
     return kExitFailed;
   }
   display.finish();

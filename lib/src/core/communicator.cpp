@@ -22,6 +22,15 @@ void SelfCommunicator::all_gather(std::span<const std::byte> mine,
   all[0].assign(mine.begin(), mine.end());
 }
 
+void SelfCommunicator::gather(std::span<const std::byte> mine,
+                              std::vector<std::vector<std::byte>>& all, int root) const {
+  if (root != 0) {
+    throw InvalidArgument("Communicator::gather: expected root 0 of 1 process, found " +
+                          std::to_string(root));
+  }
+  all_gather(mine, all);
+}
+
 void require_exchange(std::span<const int> neighbours,
                       std::span<const std::vector<std::byte>> send, int size) {
   if (send.size() != neighbours.size()) {

@@ -225,10 +225,8 @@ struct OutputFile::Impl {
   std::fstream xdmf;
   std::streamoff xdmf_footer = 0;
   // Scratch of a record.
-  std::vector<std::uint32_t> contact_order;
   std::vector<std::uint64_t> contact_ids, line_nodes;
   std::vector<double> point, normal, gap, lambda_N, lambda_T, line;
-  std::vector<std::size_t> order;
   std::vector<std::uint64_t> ids;
   std::vector<double> r, p, v, w, radius;
 };
@@ -426,10 +424,13 @@ void OutputFile::add_step(const timestep::StepReport& report, std::size_t bodies
   impl_->pending_steps.push_back(row);
 }
 
-void OutputFile::write_bodies(scene::Simulation& simulation) {
+void OutputFile::write_bodies(std::vector<timestep::BodyRecord>& created) {
   Impl& o = *impl_;
-  std::vector<timestep::BodyRecord>& created = simulation.created();
   if (created.empty()) return;
+  // In creation order, which is the order of ids (a parallel run gathers them from its processes).
+  std::sort(
+      created.begin(), created.end(),
+      [](const timestep::BodyRecord& a, const timestep::BodyRecord& b) { return a.id < b.id; });
   h5::pack_rows(created, o.packed_bodies);
   const auto& rows = o.packed_bodies;
   h5::append(o.bodies.get(), o.body_type.get(), rows.data(), rows.size(), o.file, "bodies");
@@ -445,29 +446,95 @@ void OutputFile::write_steps() {
   o.pending_steps.clear();
 }
 
-void OutputFile::flush(scene::Simulation& simulation) {
+bool OutputFile::contacts() const { return impl_->contacts; }
+
+void OutputFile::flush(scene::Simulation& simulation) { flush(simulation.created()); }
+
+void OutputFile::flush(std::vector<timestep::BodyRecord>& created) {
   std::lock_guard lock(hdf5::mutex());
   hdf5::QuietErrors quiet;
-  write_bodies(simulation);
+  write_bodies(created);
   write_steps();
   check(H5Fflush(impl_->handle.get(), H5F_SCOPE_LOCAL), impl_->file, "cannot flush");
 }
 
+// [collect contacts]
+void collect_record(scene::Simulation& simulation, bool contacts, RecordPart& part) {
+  const timestep::BodySystem& system = simulation.system();
+  const std::size_t n = system.owned_count();
+  const auto ids = system.ids();
+  const auto states = system.states();
+  part.bodies.resize(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    RecordBody& b = part.bodies[i];
+    b.id = ids[i];
+    for (int d = 0; d < 7; ++d) b.q[static_cast<std::size_t>(d)] = states[i].q[d];
+    for (int d = 0; d < 6; ++d) b.u[static_cast<std::size_t>(d)] = states[i].u[d];
+    b.radius = system.bounding_radii()[i];
+  }
+  part.created.swap(simulation.created());
+  simulation.created().clear();
+  part.contacts.clear();
+  if (!contacts) return;
+  const timestep::MoreauStepper& stepper = simulation.stepper();
+  const auto keys = stepper.keys();
+  const auto detected = stepper.contacts();
+  const auto lambda = stepper.percussions();
+  const auto& problem = stepper.problem().contacts;
+  // The last step's contacts (none before the first step).
+  const std::size_t m = stepper.steps() > 0 ? keys.size() : 0;
+  part.contacts.resize(m);
+  for (std::size_t k = 0; k < m; ++k) {
+    const collision::ContactGeometry& g = detected[k].geometry;
+    const contact::CompactContact& c = problem[k];
+    const Vector3 t2 = c.n.cross(c.t1);
+    const Vector3 tangential = lambda[k](1) * c.t1 + lambda[k](2) * t2;
+    // A line from side a to side b: a body's centre at the midpoint (contact point minus lever
+    // arm; a static object or fixed body has none, and its contact point stands in).
+    const Vector3 end_a = g.I_r_a - c.r_a, end_b = g.I_r_b - c.r_b;
+    RecordContact& row = part.contacts[k];
+    row.key = keys[k];
+    row.gap = g.g_N;
+    row.lambda_N = lambda[k](0);
+    for (int d = 0; d < 3; ++d) {
+      const auto e = static_cast<std::size_t>(d);
+      row.point[e] = 0.5 * (g.I_r_a(d) + g.I_r_b(d));
+      row.normal[e] = c.n(d);
+      row.lambda_T[e] = tangential(d);
+      row.line[e] = end_a(d);
+      row.line[3 + e] = end_b(d);
+    }
+  }
+}
+// [collect contacts]
+
 void OutputFile::write_record(scene::Simulation& simulation) {
+  RecordPart part;
+  collect_record(simulation, impl_->contacts, part);
+  write_record(simulation.stepper().time(), simulation.stepper().steps(), std::span(&part, 1));
+}
+
+void OutputFile::write_record(double t, std::uint64_t step, std::span<RecordPart> parts) {
   std::lock_guard lock(hdf5::mutex());
   hdf5::QuietErrors quiet;
   Impl& o = *impl_;
-  write_bodies(simulation);
+  {
+    std::vector<timestep::BodyRecord>& created = parts.front().created;
+    for (std::size_t k = 1; k < parts.size(); ++k) {
+      created.insert(created.end(), parts[k].created.begin(), parts[k].created.end());
+      parts[k].created.clear();
+    }
+    write_bodies(created);
+  }
   write_steps();
 
-  const timestep::BodySystem& system = simulation.system();
-  const std::size_t n = system.size();
-  const auto ids = system.ids();
-  const auto states = system.states();
-  o.order.resize(n);
-  std::iota(o.order.begin(), o.order.end(), std::size_t{0});
-  std::sort(o.order.begin(), o.order.end(),
-            [&](std::size_t a, std::size_t b) { return ids[a] < ids[b]; });
+  std::vector<RecordBody>& bodies = parts.front().bodies;
+  for (std::size_t k = 1; k < parts.size(); ++k) {
+    bodies.insert(bodies.end(), parts[k].bodies.begin(), parts[k].bodies.end());
+  }
+  std::sort(bodies.begin(), bodies.end(),
+            [](const RecordBody& a, const RecordBody& b) { return a.id < b.id; });
+  const std::size_t n = bodies.size();
   o.ids.resize(n);
   o.r.resize(3 * n);
   o.p.resize(4 * n);
@@ -475,22 +542,19 @@ void OutputFile::write_record(scene::Simulation& simulation) {
   o.w.resize(3 * n);
   o.radius.resize(n);
   for (std::size_t k = 0; k < n; ++k) {
-    const std::size_t i = o.order[k];
-    o.ids[k] = ids[i];
-    const body::State& x = states[i];
-    for (int d = 0; d < 3; ++d) {
-      o.r[3 * k + d] = x.q[d];
-      o.v[3 * k + d] = x.u[d];
-      o.w[3 * k + d] = x.u[3 + d];
+    const RecordBody& b = bodies[k];
+    o.ids[k] = b.id;
+    for (std::size_t d = 0; d < 3; ++d) {
+      o.r[3 * k + d] = b.q[d];
+      o.v[3 * k + d] = b.u[d];
+      o.w[3 * k + d] = b.u[3 + d];
     }
-    for (int d = 0; d < 4; ++d) o.p[4 * k + d] = x.q[3 + d];
-    o.radius[k] = system.bounding_radii()[i];
+    for (std::size_t d = 0; d < 4; ++d) o.p[4 * k + d] = b.q[3 + d];
+    o.radius[k] = b.radius;
   }
 
   const std::uint64_t index = written_.records;
   const std::string name = record_name(index);
-  const double t = simulation.stepper().time();
-  const std::uint64_t step = simulation.stepper().steps();
   // A record of the same index may be left from a run killed while writing it.
   if (H5Lexists(o.records.get(), name.c_str(), H5P_DEFAULT) > 0) {
     check(H5Ldelete(o.records.get(), name.c_str(), H5P_DEFAULT), o.file,
@@ -516,16 +580,26 @@ void OutputFile::write_record(scene::Simulation& simulation) {
   h5::describe(group.get(), "radius", "m", nullptr, o.file);
   h5::write_attribute(group.get(), "time", t, o.file);
   h5::write_attribute(group.get(), "step", step, o.file);
-  const std::uint64_t contacts = o.contacts ? write_contacts(group.get(), simulation) : 0;
+  std::uint64_t contacts = 0;
+  if (o.contacts) {
+    std::vector<RecordContact>& all = parts.front().contacts;
+    for (std::size_t k = 1; k < parts.size(); ++k) {
+      all.insert(all.end(), parts[k].contacts.begin(), parts[k].contacts.end());
+    }
+    std::sort(all.begin(), all.end(),
+              [](const RecordContact& a, const RecordContact& b) { return a.key < b.key; });
+    write_contacts(group.get(), all);
+    contacts = all.size();
+  }
   group.close();
-  const std::uint64_t bodies = n;
   // The tables may hold rows of a record that a killed run did not count: overwrite them.
   h5::resize(o.record_time.get(), index, o.file, "records/time");
   h5::resize(o.record_step.get(), index, o.file, "records/step");
   h5::resize(o.record_bodies.get(), index, o.file, "records/bodies");
+  const std::uint64_t count = n;
   h5::append(o.record_time.get(), H5T_NATIVE_DOUBLE, &t, 1, o.file, "records/time");
   h5::append(o.record_step.get(), H5T_NATIVE_UINT64, &step, 1, o.file, "records/step");
-  h5::append(o.record_bodies.get(), H5T_NATIVE_UINT64, &bodies, 1, o.file, "records/bodies");
+  h5::append(o.record_bodies.get(), H5T_NATIVE_UINT64, &count, 1, o.file, "records/bodies");
   if (o.contacts) {
     h5::resize(o.record_contacts.get(), index, o.file, "records/contacts");
     h5::append(o.record_contacts.get(), H5T_NATIVE_UINT64, &contacts, 1, o.file,
@@ -537,26 +611,16 @@ void OutputFile::write_record(scene::Simulation& simulation) {
   check(H5Fflush(o.handle.get(), H5F_SCOPE_LOCAL), o.file, "cannot flush");
   written_.records = index + 1;
   o.times.push_back(t);
-  o.counts.push_back(bodies);
+  o.counts.push_back(count);
   if (o.contacts) o.contact_counts.push_back(contacts);
   append_xdmf();
 }
 
 // [write contacts]
-std::uint64_t OutputFile::write_contacts(std::int64_t record, scene::Simulation& simulation) {
+void OutputFile::write_contacts(std::int64_t record, std::span<const RecordContact> contacts) {
   static_assert(std::is_same_v<hid_t, std::int64_t>);
   Impl& o = *impl_;
-  const timestep::MoreauStepper& stepper = simulation.stepper();
-  const auto keys = stepper.keys();
-  const auto detected = stepper.contacts();
-  const auto lambda = stepper.percussions();
-  const auto& problem = stepper.problem().contacts;
-  // The last step's contacts (none before the first step), sorted by key.
-  const std::size_t m = stepper.steps() > 0 ? keys.size() : 0;
-  o.contact_order.resize(m);
-  std::iota(o.contact_order.begin(), o.contact_order.end(), std::uint32_t{0});
-  std::sort(o.contact_order.begin(), o.contact_order.end(),
-            [&](std::uint32_t a, std::uint32_t b) { return keys[a] < keys[b]; });
+  const std::size_t m = contacts.size();
   o.contact_ids.resize(2 * m);
   o.point.resize(3 * m);
   o.normal.resize(3 * m);
@@ -566,25 +630,17 @@ std::uint64_t OutputFile::write_contacts(std::int64_t record, scene::Simulation&
   o.line.resize(6 * m);
   o.line_nodes.resize(2 * m);
   for (std::size_t j = 0; j < m; ++j) {
-    const std::size_t k = o.contact_order[j];
-    const collision::ContactGeometry& g = detected[k].geometry;
-    const contact::CompactContact& c = problem[k];
-    const Vector3 t2 = c.n.cross(c.t1);
-    const Vector3 tangential = lambda[k](1) * c.t1 + lambda[k](2) * t2;
-    // A line from side a to side b: a body's centre at the midpoint (contact point minus lever
-    // arm; a static object or fixed body has none, and its contact point stands in).
-    const Vector3 end_a = g.I_r_a - c.r_a, end_b = g.I_r_b - c.r_b;
-    o.contact_ids[2 * j] = keys[k].a;
-    o.contact_ids[2 * j + 1] = keys[k].b;
-    o.gap[j] = g.g_N;
-    o.lambda_N[j] = lambda[k](0);
-    for (int d = 0; d < 3; ++d) {
-      o.point[3 * j + d] = 0.5 * (g.I_r_a(d) + g.I_r_b(d));
-      o.normal[3 * j + d] = c.n(d);
-      o.lambda_T[3 * j + d] = tangential(d);
-      o.line[6 * j + d] = end_a(d);
-      o.line[6 * j + 3 + d] = end_b(d);
-    }
+    const RecordContact& c = contacts[j];
+    o.contact_ids[2 * j] = c.key.a;
+    o.contact_ids[2 * j + 1] = c.key.b;
+    o.gap[j] = c.gap;
+    o.lambda_N[j] = c.lambda_N;
+    std::copy(c.point.begin(), c.point.end(), o.point.begin() + static_cast<std::ptrdiff_t>(3 * j));
+    std::copy(c.normal.begin(), c.normal.end(),
+              o.normal.begin() + static_cast<std::ptrdiff_t>(3 * j));
+    std::copy(c.lambda_T.begin(), c.lambda_T.end(),
+              o.lambda_T.begin() + static_cast<std::ptrdiff_t>(3 * j));
+    std::copy(c.line.begin(), c.line.end(), o.line.begin() + static_cast<std::ptrdiff_t>(6 * j));
     o.line_nodes[2 * j] = 2 * j;
     o.line_nodes[2 * j + 1] = 2 * j + 1;
   }
@@ -609,15 +665,16 @@ std::uint64_t OutputFile::write_contacts(std::int64_t record, scene::Simulation&
   h5::describe(g, "lambda_T", "N s", "I", o.file);
   h5::describe(g, "line", "m", "I", o.file);
   h5::describe(g, "line_nodes", "1", nullptr, o.file);
-  return m;
 }
 // [write contacts]
 
-void OutputFile::close(scene::Simulation& simulation) {
+void OutputFile::close(scene::Simulation& simulation) { close(simulation.created()); }
+
+void OutputFile::close(std::vector<timestep::BodyRecord>& created) {
   std::lock_guard lock(hdf5::mutex());
   hdf5::QuietErrors quiet;
   Impl& o = *impl_;
-  write_bodies(simulation);
+  write_bodies(created);
   write_steps();
   for (Handle* h : {&o.record_contacts, &o.record_bodies, &o.record_step, &o.record_time,
                     &o.records, &o.steps, &o.bodies}) {

@@ -219,7 +219,7 @@ RunResult run(const scene::Scene& scene, const RunOptions& options) {
         recorded = true;
       }
       if (checkpoint_every > 0 && step % checkpoint_every == 0) save();
-      if (options.on_step) options.on_step(sim, report);
+      if (options.on_step) options.on_step(sim, report, sim.system().size());
     }
   } catch (...) {
     // A failed step (a blow-up, a diverged solver) leaves a state that is not data: no record,

@@ -160,7 +160,7 @@ std::size_t BodyExchange::migrate(timestep::BodySystem& system, timestep::WarmSt
 std::size_t BodyExchange::borders(timestep::BodySystem& system) {
   system.clear_ghosts();
   const int me = comm_.rank();
-  const Box mine = grid_.subdomain(me);
+  const Box mine = grid_.owned_region(me);
   for (std::size_t k = 0; k < neighbours_.size(); ++k) {
     out_[k].clear();
     sent_[k].rows.clear();
@@ -175,7 +175,7 @@ std::size_t BodyExchange::borders(timestep::BodySystem& system) {
     const Vector3 inside = (c - mine.min()).cwiseMin(mine.max() - c);
     if (inside.minCoeff() > reach * (1.0 + 1e-12)) continue;
     for (std::size_t k = 0; k < neighbours_.size(); ++k) {
-      const Box box = grid_.subdomain(neighbours_[k]);
+      const Box box = grid_.owned_region(neighbours_[k]);
       for (const std::array<int, 3>& s : grid_.image_shifts()) {
         const bool plain = s == std::array<int, 3>{0, 0, 0};
         if (plain && neighbours_[k] == me) continue;  // the body itself

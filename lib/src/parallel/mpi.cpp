@@ -146,6 +146,36 @@ void MpiCommunicator::all_gather(std::span<const std::byte> mine,
   }
 }
 
+void MpiCommunicator::gather(std::span<const std::byte> mine,
+                             std::vector<std::vector<std::byte>>& all, int root) const {
+  if (root < 0 || root >= size_) {
+    throw InvalidArgument("Communicator::gather: expected a root in [0, " + std::to_string(size_) +
+                          "), found " + std::to_string(root));
+  }
+  const int n = int_count(mine.size(), "Communicator::gather");
+  const bool at_root = rank_ == root;
+  std::vector<int> counts(at_root ? static_cast<std::size_t>(size_) : 0);
+  check(MPI_Gather(&n, 1, MPI_INT, counts.data(), 1, MPI_INT, root, impl_->comm),
+        "MPI_Gather (sizes)");
+  std::vector<int> offsets(counts.size());
+  std::size_t total = 0;
+  for (std::size_t r = 0; r < counts.size(); ++r) {
+    offsets[r] = int_count(total, "Communicator::gather");
+    total += static_cast<std::size_t>(counts[r]);
+  }
+  std::vector<std::byte> flat(total);
+  check(MPI_Gatherv(mine.data(), n, MPI_BYTE, flat.data(), counts.data(), offsets.data(), MPI_BYTE,
+                    root, impl_->comm),
+        "MPI_Gatherv");
+  all.clear();
+  if (!at_root) return;
+  all.resize(counts.size());
+  for (std::size_t r = 0; r < counts.size(); ++r) {
+    const auto from = flat.begin() + offsets[r];
+    all[r].assign(from, from + counts[r]);
+  }
+}
+
 // [exchange]
 void MpiCommunicator::exchange(std::span<const int> neighbours,
                                std::span<const std::vector<std::byte>> send,

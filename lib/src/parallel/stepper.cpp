@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <string>
 
 #include "grbd/core/checks.hpp"
@@ -74,6 +75,7 @@ timestep::StepReport ParallelStepper::step() {
       reference_[i] = system_.states()[i].q.head<3>();
     }
     ++rebuilds_;
+    changed_ = false;
   } else {
     exchange_.forward(system_);
   }
@@ -85,8 +87,9 @@ timestep::StepReport ParallelStepper::step() {
 // the candidate list).
 bool ParallelStepper::rebuild_due() const {
   if (rebuilds_ == 0) return true;
-  double largest = 0.0;
-  for (std::size_t i = 0; i < reference_.size(); ++i) {
+  // Bodies added or removed here: the rows moved, and every process must rebuild with this one.
+  double largest = changed_ ? std::numeric_limits<double>::infinity() : 0.0;
+  for (std::size_t i = 0; !changed_ && i < reference_.size(); ++i) {
     largest = std::max(largest, (system_.states()[i].q.head<3>() - reference_[i]).squaredNorm());
   }
   std::vector<double> global{largest};

@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <fstream>
 #include <limits>
 #include <memory>
@@ -235,7 +236,8 @@ double smallest_bounding_radius(const BodyGroup& group) {
 struct Simulation::Scratch {
   OverlapGrid grid;
   std::vector<timestep::GlobalId> owner;  // the id of each sphere in grid
-  std::vector<std::size_t> near;          // the bodies near an inflow region
+  std::vector<Vector4> near;              // the bodies near an inflow region: centre, radius
+  std::vector<std::vector<std::byte>> gathered;
   std::vector<collision::ContactGeometry> contacts;
   Scratch() = default;
 };
@@ -268,13 +270,36 @@ std::pair<double, std::size_t> Simulation::static_gap(const collision::Shape& sh
   return {gap, which};
 }
 
-Simulation::Simulation(Scene scene) : Simulation(std::move(scene), nullptr) {}
+Simulation::Simulation(Scene scene) : Simulation(std::move(scene), nullptr, nullptr) {}
 
 Simulation::Simulation(Scene scene, const SimulationState& state)
-    : Simulation(std::move(scene), &state) {}
+    : Simulation(std::move(scene), &state, nullptr) {}
 
-Simulation::Simulation(Scene scene, const SimulationState* state)
-    : scene_(std::move(scene)), scratch_(std::make_unique<Scratch>()) {
+Simulation::Simulation(Scene scene, const SimulationState* state, const Distribution& distribution)
+    : Simulation(std::move(scene), state, &distribution) {}
+
+namespace {
+
+// Chapter 6's stepper on its own: the serial run.
+class SerialEngine final : public StepEngine {
+ public:
+  SerialEngine(timestep::BodySystem& system, const timestep::StaticGeometry& statics,
+               const timestep::MaterialTable& materials, const timestep::StepSettings& settings)
+      : stepper_(system, statics, materials, settings) {}
+  timestep::StepReport step() override {
+    stepper_.reorder_if_due();  // between steps, where a parallel run migrates bodies
+    return stepper_.step();
+  }
+  timestep::MoreauStepper& stepper() override { return stepper_; }
+
+ private:
+  timestep::MoreauStepper stepper_;
+};
+
+}  // namespace
+
+Simulation::Simulation(Scene scene, const SimulationState* state, const Distribution* distribution)
+    : scene_(std::move(scene)), distribution_(distribution), scratch_(std::make_unique<Scratch>()) {
   for (const std::string& name : scene_.materials) materials_.add(name);
   if (scene_.default_contact) materials_.set_default(*scene_.default_contact);
   for (const ContactSpec& c : scene_.contacts) {
@@ -293,12 +318,15 @@ Simulation::Simulation(Scene scene, const SimulationState* state)
     restore(*state);
   }
   try {
-    stepper_.emplace(system_, statics_, materials_, scene_.settings);
+    engine_ = distribution_ != nullptr
+                  ? distribution_->engine(system_, statics_, materials_, scene_.settings)
+                  : std::make_unique<SerialEngine>(system_, statics_, materials_, scene_.settings);
   } catch (const SceneError&) {
     throw;
   } catch (const InvalidArgument& e) {
     throw SceneError(scene_.file.string() + ": " + e.what());
   }
+  stepper_ = &engine_->stepper();
   if (state != nullptr) {
     stepper_->set_clock(state->t, state->steps);
     stepper_->warm_starts().store(state->warm_keys, state->warm_lambda);
@@ -391,6 +419,9 @@ BodyRecord Simulation::make_body(std::size_t group, Random& random) {
 }
 
 void Simulation::add_body(BodyRecord record, const body::State& state) {
+  // A parallel run makes every body on every process, so that each draws the same numbers and
+  // ids, and keeps the bodies it owns.
+  if (distribution_ != nullptr && !distribution_->owns(state.q.head<3>())) return;
   record.state = state;
   system_.add(record);
   created_.push_back(std::move(record));
@@ -603,21 +634,23 @@ void Simulation::inflow() {
     const Vector3 hi = spec.region.max;
     // The bodies that reach into the region: one pass over the system, O(N) like the step
     // itself, into buffers kept between steps.
-    std::vector<std::size_t>& near = scratch_->near;
+    // (In a parallel run, the owned bodies of every process, so that every process places the
+    // same bodies.)
+    std::vector<Vector4>& near = scratch_->near;
     near.clear();
-    for (std::size_t i = 0; i < system_.size(); ++i) {
+    for (std::size_t i = 0; i < system_.owned_count(); ++i) {
       const double r = system_.bounding_radii()[i];
       const Vector3 c = system_.states()[i].q.head<3>();
       const double reach = r + r_b;
       if ((c.array() >= lo.array() - reach).all() && (c.array() <= hi.array() + reach).all()) {
-        near.push_back(i);
-        r_existing = std::max(r_existing, r);
+        near.emplace_back(c.x(), c.y(), c.z(), r);
       }
     }
+    if (distribution_ != nullptr) gather_near(near);
+    for (const Vector4& sphere : near) r_existing = std::max(r_existing, sphere[3]);
     OverlapGrid& grid = scratch_->grid;
     grid.reset(r_b + std::max(r_b, r_existing));
-    for (std::size_t i : near)
-      grid.insert(system_.states()[i].q.head<3>(), system_.bounding_radii()[i]);
+    for (const Vector4& sphere : near) grid.insert(sphere.head<3>(), sphere[3]);
     while (state.created < due) {
       // The body's radius and its tries are drawn from the saved state, so a body that does not
       // fit now is drawn again, identically, at the next step.
@@ -653,26 +686,50 @@ void Simulation::inflow() {
   }
 }
 
+void Simulation::gather_near(std::vector<Vector4>& near) {
+  std::vector<std::vector<std::byte>>& all = scratch_->gathered;
+  distribution_->communicator().all_gather(std::as_bytes(std::span(near)), all);
+  near.clear();
+  for (const std::vector<std::byte>& part : all) {
+    const std::size_t n = part.size() / sizeof(Vector4);
+    const std::size_t at = near.size();
+    near.resize(at + n);
+    std::memcpy(static_cast<void*>(near.data() + at), part.data(), n * sizeof(Vector4));
+  }
+}
+
 void Simulation::outlet() {
   if (!scene_.domain.enabled) return;
   leaving_.clear();
   const Region& box = scene_.domain.box;
   const auto states = system_.states();
-  for (std::size_t i = 0; i < states.size(); ++i) {
+  for (std::size_t i = 0; i < system_.owned_count(); ++i) {
     const auto c = states[i].q.head<3>().array();
     if ((c < box.min.array()).any() || (c > box.max.array()).any()) leaving_.push_back(i);
   }
+  double mass = 0.0;  // of this process's leaving bodies, in a parallel run
+  for (std::size_t i : leaving_)
+    (distribution_ == nullptr ? removed_mass_ : mass) += system_.inertia()[i].m;
   if (!leaving_.empty()) {
-    for (std::size_t i : leaving_) removed_mass_ += system_.inertia()[i].m;
     system_.remove(leaving_);
-    removed_ += leaving_.size();
+    engine_->bodies_changed();
   }
+  if (distribution_ == nullptr) {
+    removed_ += leaving_.size();
+    return;
+  }
+  // The counts of the whole run, the same on every process (the mass summed in rank order).
+  std::vector<double> sums{static_cast<double>(leaving_.size()), mass};
+  distribution_->communicator().sum(sums);
+  removed_ += static_cast<std::uint64_t>(sums[0]);
+  removed_mass_ += sums[1];
 }
 
 timestep::StepReport Simulation::step() {
+  const std::uint64_t before = system_.owned_count();
   inflow();
-  stepper_->reorder_if_due();  // between steps, where a parallel run migrates bodies
-  timestep::StepReport report = stepper_->step();
+  if (system_.owned_count() != before) engine_->bodies_changed();
+  timestep::StepReport report = engine_->step();
   outlet();
   return report;
 }
@@ -735,6 +792,7 @@ void Simulation::restore(const SimulationState& state) {
              std::to_string(next_id_));
     }
     require_from_scene(c);
+    if (distribution_ != nullptr && !distribution_->owns(c.state.q.head<3>())) continue;
     try {
       system_.add(c);
     } catch (const InvalidArgument& e) {

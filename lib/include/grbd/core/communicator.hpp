@@ -47,6 +47,11 @@ class Communicator {
   /// Every process's bytes, in rank order, on every process: `all[r]` is what rank r gave.
   virtual void all_gather(std::span<const std::byte> mine,
                           std::vector<std::vector<std::byte>>& all) const = 0;
+  /// Every process's bytes, in rank order, on rank `root` only (`all[r]` is what rank r gave;
+  /// `all` is emptied on the other ranks): what a record of the output needs, without a copy of
+  /// every body on every process.
+  virtual void gather(std::span<const std::byte> mine, std::vector<std::vector<std::byte>>& all,
+                      int root) const = 0;
   /// One message to each neighbour and one from each: `send[k]` goes to rank `neighbours[k]`,
   /// `received[k]` (resized) comes from it. Neighbours are symmetric (if b is a's, a is b's; each
   /// lists the other once) and may include this rank itself (periodic images at P = 1). The
@@ -74,6 +79,8 @@ class SelfCommunicator final : public Communicator {
   void broadcast(std::vector<std::byte>& bytes, int root) const override;
   void all_gather(std::span<const std::byte> mine,
                   std::vector<std::vector<std::byte>>& all) const override;
+  void gather(std::span<const std::byte> mine, std::vector<std::vector<std::byte>>& all,
+              int root) const override;
   void exchange(std::span<const int> neighbours, std::span<const std::vector<std::byte>> send,
                 std::vector<std::vector<std::byte>>& received) const override;
   void barrier() const override {}

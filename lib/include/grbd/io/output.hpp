@@ -84,6 +84,40 @@ StaticSurface static_surface(const scene::Scene& scene);
 /// The line (1, 2, …) on which two texts first differ.
 std::size_t first_different_line(std::string_view a, std::string_view b);
 
+/// One body of a record: its global id, q, u and bounding radius (120 bytes, as a process of a
+/// parallel run sends it to the one that writes).
+struct RecordBody {
+  std::uint64_t id = 0;       ///< global id
+  std::array<double, 7> q{};  ///< I_r_S [m], p (K to I)
+  std::array<double, 6> u{};  ///< I_v_S [m/s], K_omega [rad/s]
+  double radius = 0.0;        ///< bounding radius [m]
+};
+
+/// One contact of a record (with [output] contacts): its key, the geometry and the percussions as
+/// the group `contacts` of a record holds them.
+struct RecordContact {
+  timestep::ContactKey key;          ///< the contact's key: ids of sides a and b, features
+  std::array<double, 3> point{};     ///< midpoint of the two closest points [m], frame I
+  std::array<double, 3> normal{};    ///< from b towards a, frame I
+  double gap = 0.0;                  ///< g_N [m]
+  double lambda_N = 0.0;             ///< normal percussion [N s]
+  std::array<double, 3> lambda_T{};  ///< tangential percussion [N s], frame I
+  std::array<double, 6> line{};      ///< from side a's centre to side b's [m], frame I
+};
+
+/// What one process contributes to a record: its own bodies and the contacts it solved, in any
+/// order (the file holds them sorted by id and by key), and the bodies created since the last
+/// write (for /bodies).
+struct RecordPart {
+  std::vector<RecordBody> bodies;             ///< the bodies it owns
+  std::vector<RecordContact> contacts;        ///< the last step's contacts it solved
+  std::vector<timestep::BodyRecord> created;  ///< created since the last write
+};
+
+/// The part of a record that a simulation holds (its owned bodies; the contacts of its last step
+/// when `contacts`), taking the bodies it created since the last call (Simulation::created()).
+void collect_record(scene::Simulation& simulation, bool contacts, RecordPart& part);
+
 /// The output file of a run. Steps are buffered and written with each record (or flush()).
 /// While it is open, the file is locked (flock, as HDF5 does): a second OutputFile of the same
 /// file, in this process or another, is refused before anything is changed.
@@ -109,21 +143,31 @@ class OutputFile {
   /// Writes the bodies created since the last call, the buffered steps and a record of every
   /// body's q and u (rows sorted by id); flushes, then counts the record; rewrites the XDMF.
   void write_record(scene::Simulation& simulation);
+  /// The same from the parts of every process of a parallel run (or the one of a serial run):
+  /// the record of time t after `step` steps holds their bodies sorted by id, their contacts
+  /// sorted by key; /bodies gets their created bodies sorted by id. The parts are used up.
+  void write_record(double t, std::uint64_t step, std::span<RecordPart> parts);
   /// Writes the bodies created and the buffered steps, and flushes (before a checkpoint).
   void flush(scene::Simulation& simulation);
+  /// The same with the bodies created (of every process; sorted by id here, and used up).
+  void flush(std::vector<timestep::BodyRecord>& created);
+  /// Whether this file keeps the contacts of each record ([output] contacts).
+  bool contacts() const;
   /// What has been written (after flush(): everything so far).
   OutputPosition position() const { return written_; }
   /// Flushes, closes and releases the lock; throws IoError if HDF5 cannot. The destructor closes
   /// silently.
   void close(scene::Simulation& simulation);
+  /// The same with the bodies created (as flush()).
+  void close(std::vector<timestep::BodyRecord>& created);
   /// The XDMF file written beside `path`.
   static std::filesystem::path xdmf_path(const std::filesystem::path& path);
 
  private:
   struct Impl;
-  void write_bodies(scene::Simulation& simulation);
-  // The group `contacts` of a record (with [output] contacts); returns their number.
-  std::uint64_t write_contacts(std::int64_t record, scene::Simulation& simulation);
+  void write_bodies(std::vector<timestep::BodyRecord>& created);
+  // The group `contacts` of a record (with [output] contacts), sorted by key.
+  void write_contacts(std::int64_t record, std::span<const RecordContact> contacts);
   void write_steps();
   // The XDMF is written whole (atomically) when the file is created or reopened, and each record
   // is appended in place over its closing tags: O(1) per record, not O(records).

@@ -28,8 +28,10 @@ struct RunOptions {
   bool overwrite = false;
   /// Set from a signal handler: the run finishes its step, writes a checkpoint and returns.
   const volatile std::sig_atomic_t* stop = nullptr;
-  /// Called after every step (progress display).
-  std::function<void(const scene::Simulation&, const timestep::StepReport&)> on_step;
+  /// Called after every step (progress display) with the simulation, the step's report and the
+  /// number of bodies of the run. In a parallel run it is called on rank 0 only, whose simulation
+  /// holds its own bodies; the report and the number are the whole run's.
+  std::function<void(const scene::Simulation&, const timestep::StepReport&, std::uint64_t)> on_step;
   /// Called with a warning the run goes on after: a restart whose scene text differs from the
   /// checkpoint's (the first line that differs). Without it, warnings are not reported.
   std::function<void(const std::string&)> on_warning;

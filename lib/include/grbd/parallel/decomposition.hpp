@@ -51,6 +51,10 @@ class CartesianGrid {
   int rank_of(const std::array<int, 3>& cell) const;  ///< i + n_x (j + n_y k)
   /// The box of a rank's subdomain.
   Box subdomain(int rank) const;
+  /// The region whose bodies a rank owns: its subdomain, extended to ±∞ along each non-periodic
+  /// axis where it ends the domain (a body outside the domain belongs to the nearest subdomain,
+  /// and its ghosts must go where its contacts are, also beyond the domain).
+  Box owned_region(int rank) const;
 
   /// The shifts s ∈ {−1, 0, 1}³, in periods, that the periodic axes allow — the images of a
   /// position or a subdomain — (0, 0, 0) first.

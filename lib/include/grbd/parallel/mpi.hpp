@@ -39,6 +39,8 @@ class MpiCommunicator final : public Communicator {
   void broadcast(std::vector<std::byte>& bytes, int root) const override;
   void all_gather(std::span<const std::byte> mine,
                   std::vector<std::vector<std::byte>>& all) const override;
+  void gather(std::span<const std::byte> mine, std::vector<std::vector<std::byte>>& all,
+              int root) const override;
   void exchange(std::span<const int> neighbours, std::span<const std::vector<std::byte>> send,
                 std::vector<std::vector<std::byte>>& received) const override;
   void barrier() const override;

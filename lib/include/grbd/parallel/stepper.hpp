@@ -14,6 +14,7 @@
 #include "grbd/core/communicator.hpp"
 #include "grbd/parallel/decomposition.hpp"
 #include "grbd/parallel/exchange.hpp"
+#include "grbd/scene/simulation.hpp"
 #include "grbd/timestep/stepper.hpp"
 
 namespace grbd::parallel {
@@ -46,7 +47,7 @@ struct ParallelSettings {
 ///   energies over the processes (in rank order) and takes the largest residual, penetration and
 ///   iteration count.
 /// With one process and no periodic axis there are no ghosts, and the step is the serial step.
-class ParallelStepper {
+class ParallelStepper final : public scene::StepEngine {
  public:
   /// Throws InvalidArgument when settings.tolerance_radius is 0 (the active set of a parallel run
   /// must not depend on the bodies a process holds: take it from the scene), when max_radius is not
@@ -54,15 +55,18 @@ class ParallelStepper {
   ParallelStepper(const Communicator& comm, const CartesianGrid& grid, timestep::BodySystem& system,
                   const timestep::StaticGeometry& statics, const timestep::MaterialTable& materials,
                   timestep::StepSettings settings, ParallelSettings parallel);
-  ~ParallelStepper();
+  ~ParallelStepper() override;
   ParallelStepper(const ParallelStepper&) = delete;
   ParallelStepper& operator=(const ParallelStepper&) = delete;
 
   /// One step of every process; the report is the global one (the same on every process).
-  timestep::StepReport step();
+  timestep::StepReport step() override;
 
   /// The serial stepper underneath (its contacts, percussions and warm starts are this process's).
   const timestep::MoreauStepper& stepper() const { return *stepper_; }
+  timestep::MoreauStepper& stepper() override { return *stepper_; }  ///< the same
+  /// Bodies were added or removed since the last step: the next step rebuilds the ghosts.
+  void bodies_changed() override { changed_ = true; }
   /// How often the ghosts were rebuilt.
   std::uint64_t rebuilds() const { return rebuilds_; }
   /// Bodies owned here that were split in the last step (their copies elsewhere had contacts).
@@ -92,6 +96,7 @@ class ParallelStepper {
   std::uint64_t rebuilds_ = 0;
   std::size_t split_owned_ = 0;
   bool any_split_ = false;
+  bool changed_ = false;  // bodies added or removed here since the last rebuild
 };
 
 }  // namespace grbd::parallel

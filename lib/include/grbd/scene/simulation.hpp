@@ -11,6 +11,7 @@
 #include <utility>
 #include <vector>
 
+#include "grbd/core/communicator.hpp"
 #include "grbd/scene/scene.hpp"
 #include "grbd/timestep/body_system.hpp"
 #include "grbd/timestep/materials.hpp"
@@ -50,6 +51,37 @@ class StateError : public Error {
 /// can still take before anything is allocated.
 inline constexpr double kBytesPerBody = 4096.0;
 
+/// The step a Simulation takes: chapter 6's MoreauStepper on its own (the serial run), or chapter
+/// 8's parallel step around one.
+class StepEngine {
+ public:
+  virtual ~StepEngine() = default;
+  /// One step of the bodies (collective in a parallel run).
+  virtual timestep::StepReport step() = 0;
+  /// The stepper that does the work (its contacts, percussions, warm starts, clock).
+  virtual timestep::MoreauStepper& stepper() = 0;
+  /// Told when bodies were added or removed between steps (inflow, outlet).
+  virtual void bodies_changed() {}
+};
+
+/// How the processes of a parallel run share a scene (chapter 8), handed to a Simulation by the
+/// parallel module; a serial run has none. Every process makes every body a generator makes, in
+/// the same order and with the same ids, and keeps those it owns; the inflow sees the bodies of
+/// every process near its region; the outlet's counts are summed over the processes.
+class Distribution {
+ public:
+  virtual ~Distribution() = default;
+  /// The processes of the run.
+  virtual const Communicator& communicator() const = 0;
+  /// Whether this process owns a body whose centre is at `centre`.
+  virtual bool owns(const Vector3& centre) const = 0;
+  /// The engine that steps this process's bodies.
+  virtual std::unique_ptr<StepEngine> engine(timestep::BodySystem& system,
+                                             const timestep::StaticGeometry& statics,
+                                             const timestep::MaterialTable& materials,
+                                             const timestep::StepSettings& settings) const = 0;
+};
+
 /// A runnable scene. Construction generates the initial bodies (list, lattice and packing
 /// groups) and checks everything the stepper checks (materials of every pair, supported shape
 /// pairs); a scene that cannot run throws SceneError before the first step.
@@ -63,6 +95,10 @@ class Simulation {
   /// Δt, a material it does not have, a body that no group makes (shape, material, size, mass and
   /// inertia from its density or mass), or a body the system refuses.
   Simulation(Scene scene, const SimulationState& state);
+  /// The same on one process of a parallel run: the system holds the bodies `distribution` says
+  /// this process owns (and, while stepping, ghosts of its neighbours' bodies), and step() is
+  /// collective. `distribution` must outlive the simulation; `state` may be null (a fresh run).
+  Simulation(Scene scene, const SimulationState* state, const Distribution& distribution);
   ~Simulation();
   Simulation(const Simulation&) = delete;
   Simulation& operator=(const Simulation&) = delete;
@@ -72,8 +108,11 @@ class Simulation {
   timestep::StepReport step();
   /// True when the scene's number of steps is done.
   bool finished() const { return stepper_->steps() >= scene_.steps(); }
+  /// Whether this is one process of a parallel run (its system holds only its own bodies).
+  bool distributed() const { return distribution_ != nullptr; }
 
-  /// Everything the next step depends on.
+  /// Everything the next step depends on (in a parallel run: this process's bodies and warm
+  /// starts, and the counts of the whole run).
   SimulationState save() const;
 
   /// \name Parts
@@ -84,6 +123,7 @@ class Simulation {
   const timestep::MaterialTable& materials() const { return materials_; }  ///< materials
   timestep::MoreauStepper& stepper() { return *stepper_; }                 ///< the stepper
   const timestep::MoreauStepper& stepper() const { return *stepper_; }     ///< the stepper
+  const Distribution* distribution() const { return distribution_; }       ///< null: serial
   ///@}
   /// Bodies created since the caller last emptied this list (their records, in the state they
   /// were created with), for the output.
@@ -97,13 +137,14 @@ class Simulation {
   std::uint64_t inflow_backlog() const { return backlog_; }
 
  private:
-  Simulation(Scene scene, const SimulationState* state);
+  Simulation(Scene scene, const SimulationState* state, const Distribution* distribution);
   void restore(const SimulationState& state);
   void build_static();
   void generate_initial();
   void add_body(timestep::BodyRecord record, const body::State& state);
   void inflow();
   void outlet();
+  void gather_near(std::vector<Vector4>& near);
   void check_shapes() const;
   timestep::BodyRecord make_body(std::size_t group, Random& random);
   timestep::BodyRecord body_for(const BodyGroup& group, double radius) const;
@@ -119,7 +160,9 @@ class Simulation {
   timestep::MaterialTable materials_;
   timestep::StaticGeometry statics_;
   timestep::BodySystem system_;
-  std::optional<timestep::MoreauStepper> stepper_;
+  const Distribution* distribution_ = nullptr;
+  std::unique_ptr<StepEngine> engine_;
+  timestep::MoreauStepper* stepper_ = nullptr;
   std::vector<timestep::BodyRecord> created_;
   std::vector<GeneratorState> generators_;
   std::uint64_t next_id_ = 0;

@@ -1,0 +1,65 @@
+#pragma once
+/// \file
+/// \brief `mpirun -np P grbd run scene.toml` (chapter 8): a scene's run on the processes of a
+/// communicator — the same generators, output, checkpoints and restart as chapter 7's serial run,
+/// the bodies shared by a Cartesian grid of subdomains and stepped by the ParallelStepper.
+
+#include <memory>
+
+#include "grbd/core/communicator.hpp"
+#include "grbd/io/run.hpp"
+#include "grbd/parallel/decomposition.hpp"
+#include "grbd/parallel/stepper.hpp"
+#include "grbd/scene/simulation.hpp"
+
+namespace grbd::parallel {
+
+/// The box a scene's run is cut into subdomains over: the outlet's box when the scene has one,
+/// else the box in which the output draws the static half-spaces (the regions and positions of
+/// the body groups and the finite static objects, enlarged by 5 %, io::StaticSurface::bounds).
+/// Bodies outside it belong to the nearest subdomain.
+Box decomposition_box(const scene::Scene& scene);
+
+/// A scene shared by the processes of a communicator: a CartesianGrid over decomposition_box()
+/// with grid_dims() subdomains, each process owning the bodies whose centre lies in its own, and
+/// a ParallelStepper for each. Its step settings are the scene's, with a skin of half the scene's
+/// tolerance radius when the scene gives none (the ghosts and the candidate pairs are rebuilt
+/// when a body has moved a quarter of the smallest radius).
+class SceneDecomposition final : public scene::Distribution {
+ public:
+  SceneDecomposition(const Communicator& comm, const scene::Scene& scene);
+  const Communicator& communicator() const override { return comm_; }
+  bool owns(const Vector3& centre) const override { return grid_.owner_of(centre) == comm_.rank(); }
+  std::unique_ptr<scene::StepEngine> engine(timestep::BodySystem& system,
+                                            const timestep::StaticGeometry& statics,
+                                            const timestep::MaterialTable& materials,
+                                            const timestep::StepSettings& settings) const override;
+  /// The grid of subdomains.
+  const CartesianGrid& grid() const { return grid_; }
+  /// The parallel step's settings (largest bounding radius of the scene's groups).
+  const ParallelSettings& settings() const { return parallel_; }
+
+ private:
+  const Communicator& comm_;
+  CartesianGrid grid_;
+  ParallelSettings parallel_;
+};
+
+/// io::run() on every process of `comm` (collective): the same checks, records, checkpoints and
+/// restart, and the same files, written by rank 0 from the parts every process sends it (records
+/// with their bodies in ascending id, contacts by key; checkpoints with the bodies in ascending id
+/// and the warm starts by key, so that any number of processes can continue from them).
+///
+/// An error that every process sees alike or that one process finds before the first step or
+/// while writing (bad files, a scene or checkpoint that does not fit) is thrown on every process
+/// with the message of the lowest rank that found it, as the same kind of grbd::Error. A step
+/// that fails on some process (a blow-up, a diverged solver) ends every process through
+/// abort_run() with exit code 1, the output holding every record before it.
+///
+/// The stop (options.stop, set by a signal) is agreed at every step boundary: when it is set on
+/// any process, every process stops there, and the run writes its checkpoint and returns.
+/// Progress (options.on_step) and warnings are given on rank 0 only.
+io::RunResult run(const scene::Scene& scene, const io::RunOptions& options,
+                  const Communicator& comm);
+
+}  // namespace grbd::parallel
