@@ -179,7 +179,9 @@ void ParallelStepper::reduce(timestep::StepReport& report) const {
   report.warm_started = static_cast<std::size_t>(sums[1]);
   report.kinetic_energy = sums[2];
   report.potential_energy = sums[3];
-  report.iterations = static_cast<int>(maxima[0]);
+  // Without a contact on any process the solve had nothing to do; the processes still swept once
+  // together (each must learn that the others have no contacts): the serial count is 0.
+  report.iterations = report.contacts == 0 ? 0 : static_cast<int>(maxima[0]);
   report.residual = maxima[1];
   report.max_penetration = maxima[2];
   report.converged = maxima[3] == 0.0;
