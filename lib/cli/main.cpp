@@ -13,8 +13,14 @@
 //   2    bad command line
 //   3    bad input: a scene, checkpoint, output or FCLIB file that cannot be used (nothing was
 //        run)
+//   4    stopped because the stop file (--stop-file, default <checkpoint>.stop) appeared: the
+//        step was finished, a checkpoint written, the output closed and the stop file removed
 //   130  stopped by SIGINT, 143 by SIGTERM: the step was finished, a checkpoint written and the
 //        output closed; `grbd run <scene> --restart <checkpoint>` continues
+//
+// Under mpirun (mpirun -np P grbd run ...) the run is shared among the processes (chapter 8):
+// rank 0 prints progress, summary and errors; every process exits with the same code, except
+// after a failed step, which ends every process through MPI_Abort with code 1.
 
 #include <spawn.h>
 #include <sys/wait.h>
@@ -56,13 +62,15 @@ namespace {
 constexpr int kExitFailed = 1;
 constexpr int kExitUsage = 2;
 constexpr int kExitInput = 3;
+constexpr int kExitStopFile = 4;
 
 constexpr const char* kExitCodes =
     "Exit codes: 0 done; 1 the run failed (a solver diverged, a state blew up, a file could not be "
     "written, out of memory); 2 bad command line (also: files that coincide); 3 bad input "
     "(scene, checkpoint, output or FCLIB file; an output folder that cannot be written; an "
-    "existing result without --force), nothing run or changed; 130 / 143 stopped by SIGINT / "
-    "SIGTERM after writing a checkpoint (continue with --restart).";
+    "existing result without --force), nothing run or changed; 4 stopped by the stop file after "
+    "writing a checkpoint; 130 / 143 stopped by SIGINT / SIGTERM after writing a checkpoint "
+    "(continue with --restart). Under mpirun, a failed step ends every process with 1.";
 constexpr const char* kSceneFormat =
     "The scene format: chapter 7 of the book, section \"Scene files\" (every key, its unit, "
     "default and range).";
@@ -138,7 +146,7 @@ class Progress {
     const double window = std::chrono::duration<double>(now - samples_.front().first).count();
     const double since_start = std::chrono::duration<double>(now - start_).count();
     const double rate =
-        window > 0.0 ? static_cast<double>(report.step - samples_.front().second) / window
+        window > 0.0        ? static_cast<double>(report.step - samples_.front().second) / window
         : since_start > 0.0 ? static_cast<double>(report.step - first_step_) / since_start
                             : 0.0;
     const double remaining = rate > 0.0 ? static_cast<double>(total_ - report.step) / rate : -1.0;
@@ -177,8 +185,10 @@ class Progress {
 
 int run_command(const std::string& scene_file, const std::optional<std::string>& output,
                 const std::optional<std::string>& checkpoint,
-                const std::optional<std::string>& restart, const std::optional<std::string>& end_time,
-                bool force, bool quiet, const std::string& progress) {
+                const std::optional<std::string>& restart,
+                const std::optional<std::string>& end_time,
+                const std::optional<std::string>& stop_file, bool force, bool quiet,
+                const std::string& progress) {
   // Under mpirun: MPI for the run, rank 0 speaks for every process (one progress display, one
   // summary, one message per error); each process exits with the same code.
   const grbd::parallel::MpiEnvironment mpi;
@@ -208,6 +218,8 @@ int run_command(const std::string& scene_file, const std::optional<std::string>&
   options.checkpoint = checkpoint ? std::filesystem::path(*checkpoint) : scene.checkpoint.file;
   if (restart) options.restart = *restart;
   options.overwrite = force;
+  options.stop_file = stop_file ? std::filesystem::path(*stop_file)
+                                : std::filesystem::path(options.checkpoint.string() + ".stop");
   const bool bar = progress == "bar" || (progress == "auto" && isatty(STDERR_FILENO) != 0);
   Progress display(bar, scene.steps());
   bool started = false;  // an error after the first step is a failed run, not bad input
@@ -250,6 +262,7 @@ int run_command(const std::string& scene_file, const std::optional<std::string>&
               << result.records << " records in " << options.output.string() << ", checkpoint "
               << options.checkpoint.string() << '\n';
   }
+  if (result.stop_file) return kExitStopFile;
   if (result.interrupted) return 128 + static_cast<int>(g_signal);
   return 0;
 }
@@ -465,7 +478,7 @@ int grbd_main(int argc, char** argv) {
   app.require_subcommand(1);
 
   std::string scene_file;
-  std::optional<std::string> output, checkpoint, restart, end_time;
+  std::optional<std::string> output, checkpoint, restart, end_time, stop_file;
   bool quiet = false, force = false;
   std::string progress = "auto";
   CLI::App* run = app.add_subcommand("run", "Run a scene file: HDF5 + XDMF output, checkpoints");
@@ -480,6 +493,9 @@ int grbd_main(int argc, char** argv) {
   run->add_option("--end-time", end_time,
                   "Run to this time [s] instead of the scene's end_time (the same rules: a "
                   "decimal number > 0, at most 10^12 steps)");
+  run->add_option("--stop-file", stop_file,
+                  "When this file appears, finish the step, write a checkpoint, remove the file "
+                  "and stop with exit code 4 (default: the checkpoint's name + .stop)");
   run->add_flag("-f,--force", force,
                 "Replace an existing output, XDMF and checkpoint (a fresh run refuses to)");
   run->add_flag("-q,--quiet", quiet, "No progress and no summary; errors only");
@@ -521,8 +537,9 @@ int grbd_main(int argc, char** argv) {
             return {};
           },
           "T > 0"));
-  fclib->add_option("--max-iterations", fclib_max_iterations,
-                    "At most this many iterations per solver and problem, default 20000")
+  fclib
+      ->add_option("--max-iterations", fclib_max_iterations,
+                   "At most this many iterations per solver and problem, default 20000")
       ->check(CLI::Range(1, 1 << 30));
   fclib->add_option("--csv", fclib_csv, "Write every iteration's |F|/|q| to this CSV file");
   fclib->footer(kFclibExitCodes);
@@ -568,7 +585,8 @@ int grbd_main(int argc, char** argv) {
   // Memory that runs out is an error with a message and an exit code, never an abort.
   try {
     if (run->parsed())
-      return run_command(scene_file, output, checkpoint, restart, end_time, force, quiet, progress);
+      return run_command(scene_file, output, checkpoint, restart, end_time, stop_file, force, quiet,
+                         progress);
     if (validate->parsed()) return validate_command(validate_file);
     if (info->parsed()) return info_command(info_file);
     if (fclib->parsed())

@@ -201,6 +201,32 @@ class Failures(Runs):
             self.assertAlmostEqual(float(f["records/time"][int(f["records"].attrs["count"]) - 1]),
                                    0.2, delta=1e-12)
 
+    def test_the_stop_file_stops_every_process_with_a_checkpoint(self):
+        for processes in (2, 0):
+            out, ckpt = self.path(f"s{processes}.h5"), self.path(f"s{processes}.c.h5")
+            stop = ckpt + ".stop"
+            launcher = [] if processes == 0 else [MPIEXEC, "-n", str(processes),
+                                                  "--oversubscribe", "--bind-to", "none"]
+            process = subprocess.Popen([*launcher, GRBD, "run", PILE, "-q", "-o", out, "-c",
+                                        ckpt, "--end-time", "0.2"],
+                                       stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+            deadline = time.monotonic() + 120
+            while not os.path.exists(out) and time.monotonic() < deadline:
+                time.sleep(0.2)
+            time.sleep(1.0)
+            open(stop, "w").close()
+            _, stderr = process.communicate(timeout=120)
+            # mpiexec reports a process's non-zero code; the serial run exits with it
+            self.assertNotEqual(process.returncode, 0, stderr)
+            if processes == 0:
+                self.assertEqual(process.returncode, 4, stderr)
+            self.assertFalse(os.path.exists(stop), "the stop file is removed once honoured")
+            with h5py.File(ckpt, "r") as f:
+                steps = int(f.attrs["steps"])
+            with h5py.File(out, "r") as f:
+                self.assertEqual(len(f["steps"]), steps)
+            self.assertLess(steps, 1000, "the run ended before the stop file: nothing was tested")
+
 
 if __name__ == "__main__":
     GRBD, MPIEXEC, BALLISTIC, PILE = sys.argv[1:5]

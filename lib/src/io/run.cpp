@@ -38,9 +38,10 @@ std::string scene_difference(const std::string& saved, const std::string& given,
     return begin >= text.size() ? std::string("the end of the file")
                                 : '"' + std::string(line_of(text, begin)) + '"';
   };
-  return scene_file.string() + ":" + std::to_string(line) + ": the scene differs from the one the " +
-         "checkpoint was written with: it has " + quoted(given) + ", the checkpoint's has " +
-         quoted(saved) + "; the run continues with the scene given";
+  return scene_file.string() + ":" + std::to_string(line) +
+         ": the scene differs from the one the " + "checkpoint was written with: it has " +
+         quoted(given) + ", the checkpoint's has " + quoted(saved) +
+         "; the run continues with the scene given";
 }
 
 bool same_file(const std::filesystem::path& a, const std::filesystem::path& b) {
@@ -139,7 +140,8 @@ void check_run_files(const scene::Scene& scene, const RunOptions& options) {
     for (const File& f : {written[0], written[1], written[2]}) {
       std::error_code error;
       if (fs::exists(fs::symlink_status(f.path, error))) {
-        throw IoError(f.path.string() + ": " + f.role + " exists already: a fresh run does not "
+        throw IoError(f.path.string() + ": " + f.role +
+                      " exists already: a fresh run does not "
                       "replace an earlier result; give another name, continue it with --restart, "
                       "or replace it with --force");
       }
@@ -147,29 +149,50 @@ void check_run_files(const scene::Scene& scene, const RunOptions& options) {
   }
 }
 
+bool stop_requested(const RunOptions& options) {
+  std::error_code error;
+  return !options.stop_file.empty() && std::filesystem::exists(options.stop_file, error);
+}
+
+void remove_stop_file(const RunOptions& options) {
+  std::error_code error;
+  std::filesystem::remove(options.stop_file, error);
+}
+
+void clear_stale_stop_file(const RunOptions& options) {
+  if (!stop_requested(options)) return;
+  remove_stop_file(options);
+  if (options.on_warning) {
+    options.on_warning(options.stop_file.string() +
+                       ": removed the stop file that an earlier run left (it asks a run to stop)");
+  }
+}
+
 RunResult run(const scene::Scene& scene, const RunOptions& options) {
   const auto start = std::chrono::steady_clock::now();
   check_run_files(scene, options);
+  clear_stale_stop_file(options);
   RunResult result;
   std::unique_ptr<scene::Simulation> simulation;
   std::unique_ptr<OutputFile> output;
   if (options.restart) {
     const Checkpoint checkpoint = read_checkpoint(*options.restart);
-    if (const std::string difference = scene_difference(checkpoint.scene_text, scene.text, scene.file);
+    if (const std::string difference =
+            scene_difference(checkpoint.scene_text, scene.text, scene.file);
         !difference.empty() && options.on_warning) {
       options.on_warning(difference);
     }
     try {
       simulation = std::make_unique<scene::Simulation>(scene, checkpoint.state);
     } catch (const scene::StateError& e) {  // the checkpoint is at fault, not the scene
-      throw IoError(options.restart->string() + ": does not fit the scene " +
-                    scene.file.string() + ": " + e.what());
+      throw IoError(options.restart->string() + ": does not fit the scene " + scene.file.string() +
+                    ": " + e.what());
     }
     std::error_code error;
     if (std::filesystem::exists(options.output, error)) {
-      output = std::make_unique<OutputFile>(
-          options.output, scene, checkpoint.output,
-          RunIdentity{checkpoint.scene_text, checkpoint.state.bodies});
+      output =
+          std::make_unique<OutputFile>(options.output, scene, checkpoint.output,
+                                       RunIdentity{checkpoint.scene_text, checkpoint.state.bodies});
     } else {
       // A new output: its body table starts with every body of the checkpoint.
       output = std::make_unique<OutputFile>(options.output, scene);
@@ -203,6 +226,10 @@ RunResult run(const scene::Scene& scene, const RunOptions& options) {
     while (!sim.finished()) {
       if (options.stop != nullptr && *options.stop != 0) {
         result.interrupted = true;
+        break;
+      }
+      if (stop_requested(options)) {
+        result.interrupted = result.stop_file = true;
         break;
       }
       const auto t0 = std::chrono::steady_clock::now();
@@ -240,6 +267,7 @@ RunResult run(const scene::Scene& scene, const RunOptions& options) {
     result.output_seconds += seconds_since(t1);
   }
   output->close(sim);
+  if (result.stop_file) remove_stop_file(options);
   result.records = output->position().records;
   result.seconds = seconds_since(start);
   return result;

@@ -244,7 +244,9 @@ io::RunResult run(const scene::Scene& scene, const io::RunOptions& options,
   const auto start = std::chrono::steady_clock::now();
   const bool root = comm.rank() == 0;
   agreed(comm, [&] {
-    if (root) io::check_run_files(scene, options);
+    if (!root) return;
+    io::check_run_files(scene, options);
+    io::clear_stale_stop_file(options);
   });
   std::optional<SceneDecomposition> decomposition;
   agreed(comm, [&] { decomposition.emplace(comm, scene); });
@@ -340,9 +342,13 @@ io::RunResult run(const scene::Scene& scene, const io::RunOptions& options,
   bool recorded = !options.restart || (every > 0 && sim.stepper().steps() % every == 0);
   while (true) {
     // The stop and the end, agreed by every process at a step boundary.
-    const bool stop = options.stop != nullptr && *options.stop != 0;
-    if (comm.any(stop)) {
+    const bool by_file = root && io::stop_requested(options);
+    const bool stop = by_file || (options.stop != nullptr && *options.stop != 0);
+    std::vector<double> stops{stop ? 1.0 : 0.0, by_file ? 1.0 : 0.0};
+    comm.max(stops);
+    if (stops[0] > 0.0) {
       result.interrupted = true;
+      result.stop_file = stops[1] > 0.0;
       break;
     }
     if (sim.finished()) break;
@@ -381,6 +387,7 @@ io::RunResult run(const scene::Scene& scene, const io::RunOptions& options,
   agreed(comm, [&] {
     if (root) output->close(created);
   });
+  if (root && result.stop_file) io::remove_stop_file(options);
   std::vector<std::byte> records(sizeof(std::uint64_t));
   if (root) {
     const std::uint64_t n = output->position().records;

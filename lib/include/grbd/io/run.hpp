@@ -28,6 +28,11 @@ struct RunOptions {
   bool overwrite = false;
   /// Set from a signal handler: the run finishes its step, writes a checkpoint and returns.
   const volatile std::sig_atomic_t* stop = nullptr;
+  /// A file whose existence asks the run to stop as on a signal: it is looked for at every step
+  /// boundary (by rank 0 of a parallel run), and removed once the checkpoint is written. What a
+  /// job on a cluster touches before its time is up, when a signal to mpirun might not leave the
+  /// processes time enough to finish. Empty: none.
+  std::filesystem::path stop_file;
   /// Called after every step (progress display) with the simulation, the step's report and the
   /// number of bodies of the run. In a parallel run it is called on rank 0 only, whose simulation
   /// holds its own bodies; the report and the number are the whole run's.
@@ -61,9 +66,18 @@ bool same_file(const std::filesystem::path& a, const std::filesystem::path& b);
 /// checkpoint that exists already. run() calls it first.
 void check_run_files(const scene::Scene& scene, const RunOptions& options);
 
+/// Whether options.stop_file exists (the run is asked to stop).
+bool stop_requested(const RunOptions& options);
+/// Removes options.stop_file once the stop it asked for is done (a missing file is no error).
+void remove_stop_file(const RunOptions& options);
+/// Removes a stop file that is there before the run starts (an earlier run was killed before it
+/// could remove it), with a warning through options.on_warning.
+void clear_stale_stop_file(const RunOptions& options);
+
 /// What a run did.
 struct RunResult {
-  bool interrupted = false;       ///< stopped by *stop before the end
+  bool interrupted = false;       ///< stopped by *stop or the stop file before the end
+  bool stop_file = false;         ///< stopped by the stop file
   std::uint64_t steps = 0;        ///< steps done by this run
   std::uint64_t records = 0;      ///< records in the output at the end
   std::uint64_t checkpoints = 0;  ///< checkpoints written by this run
