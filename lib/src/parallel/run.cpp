@@ -49,6 +49,7 @@ enum class ErrorKind : std::uint8_t { file_conflict, io, scene, state, memory, o
   throw Error(message);
 }
 
+// [agreed]
 // Runs `work` on this process; when it throws here or on another process, every process throws
 // the error of the lowest rank that had one (collective). The way an error that only some
 // processes find — a file only rank 0 writes, a body only its owner checks — ends them all alike.
@@ -87,6 +88,7 @@ void agreed(const Communicator& comm, Work&& work) {
     rethrow(kind, message);
   }
 }
+// [agreed]
 
 // Plain values into a byte buffer and back.
 template <class T>
@@ -238,7 +240,6 @@ std::unique_ptr<scene::StepEngine> SceneDecomposition::engine(
   return std::make_unique<ParallelStepper>(comm_, grid_, system, statics, materials, s, parallel_);
 }
 
-// [parallel run]
 io::RunResult run(const scene::Scene& scene, const io::RunOptions& options,
                   const Communicator& comm) {
   const auto start = std::chrono::steady_clock::now();
@@ -341,6 +342,7 @@ io::RunResult run(const scene::Scene& scene, const io::RunOptions& options,
   };
   bool recorded = !options.restart || (every > 0 && sim.stepper().steps() % every == 0);
   while (true) {
+    // [agreed stop]
     // The stop and the end, agreed by every process at a step boundary.
     const bool by_file = root && io::stop_requested(options);
     const bool stop = by_file || (options.stop != nullptr && *options.stop != 0);
@@ -352,6 +354,7 @@ io::RunResult run(const scene::Scene& scene, const io::RunOptions& options,
       break;
     }
     if (sim.finished()) break;
+    // [agreed stop]
     const auto t0 = std::chrono::steady_clock::now();
     timestep::StepReport report;
     try {
@@ -398,6 +401,5 @@ io::RunResult run(const scene::Scene& scene, const io::RunOptions& options,
   result.seconds = seconds_since(start);
   return result;
 }
-// [parallel run]
 
 }  // namespace grbd::parallel

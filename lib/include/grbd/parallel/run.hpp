@@ -27,9 +27,15 @@ Box decomposition_box(const scene::Scene& scene);
 /// when a body has moved a quarter of the smallest radius).
 class SceneDecomposition final : public scene::Distribution {
  public:
+  /// The grid for `comm.size()` processes over decomposition_box(scene); throws InvalidArgument
+  /// when that box is empty or not finite.
   SceneDecomposition(const Communicator& comm, const scene::Scene& scene);
+  /// The processes of the run.
   const Communicator& communicator() const override { return comm_; }
+  /// Whether the grid gives a body centred at `centre` to this process.
   bool owns(const Vector3& centre) const override { return grid_.owner_of(centre) == comm_.rank(); }
+  /// A ParallelStepper over the grid (the scene's settings, with a skin of half the tolerance
+  /// radius when they give none).
   std::unique_ptr<scene::StepEngine> engine(timestep::BodySystem& system,
                                             const timestep::StaticGeometry& statics,
                                             const timestep::MaterialTable& materials,
