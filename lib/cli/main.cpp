@@ -236,8 +236,10 @@ int run_command(const std::string& scene_file, const std::optional<std::string>&
   grbd::io::RunResult result;
   try {
     // One process takes exactly the serial path.
-    result = world.size() > 1 ? grbd::parallel::run(scene, options, world)
-                              : grbd::io::run(scene, options);
+    // A periodic scene runs on the parallel engine, also on one process.
+    result = world.size() > 1 || scene.domain.any_periodic()
+                 ? grbd::parallel::run(scene, options, world)
+                 : grbd::io::run(scene, options);
   } catch (const grbd::io::FileConflict& e) {
     errors << "grbd run: " << e.what() << '\n';
     return kExitUsage;
@@ -272,10 +274,14 @@ int validate_command(const std::string& scene_file) {
     const grbd::scene::Scene scene = grbd::scene::load_scene(scene_file);
     std::cout << grbd::scene::summary(scene);
     const auto start = std::chrono::steady_clock::now();
-    grbd::scene::Simulation simulation(scene);
+    // A periodic scene is built as its run builds it, on the parallel engine of one process.
+    std::optional<grbd::parallel::SceneDecomposition> one;
+    if (scene.domain.any_periodic()) one.emplace(grbd::self_communicator(), scene);
+    const auto simulation = one ? std::make_unique<grbd::scene::Simulation>(scene, nullptr, *one)
+                                : std::make_unique<grbd::scene::Simulation>(scene);
     const double seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    std::cout << "  generated " << simulation.system().size() << " bodies in "
+    std::cout << "  generated " << simulation->system().size() << " bodies in "
               << std::setprecision(3) << seconds << " s\n";
     for (std::size_t g = 0; g < scene.groups.size(); ++g) {
       if (scene.groups[g].generator.kind == grbd::scene::GeneratorKind::inflow) {

@@ -228,6 +228,116 @@ class Failures(Runs):
             self.assertLess(steps, 1000, "the run ended before the stop file: nothing was tested")
 
 
+class Periodic(Runs):
+    """A periodic box is the central cell of the box tiled 3 × 3 with its copies."""
+
+    L = 0.04  # the period along x and y [m]
+
+    def gas(self):
+        """16 spheres of radius 2 mm in a layer, with random velocities in the plane."""
+        rng = np.random.default_rng(4)
+        centres, r = [], 0.002
+        while len(centres) < 16:
+            c = rng.uniform(0.0, self.L, 2)
+            d = [np.linalg.norm((c - o) - self.L * np.round((c - o) / self.L)) for o in centres]
+            if all(x > 2.5 * r for x in d):
+                centres.append(c)
+        velocities = rng.uniform(-0.4, 0.4, (16, 2))
+        return np.array(centres), velocities, r
+
+    def scene(self, name, tiles, periodic):
+        centres, velocities, r = self.gas()
+        text = ("[simulation]\ndt = 1e-3\nend_time = 0.05\ngravity = [0.0, 0.0, 0.0]\n")
+        if periodic:
+            text += (f"domain = {{ min = [0.0, 0.0, -0.01], max = [{self.L}, {self.L}, 0.01] }}\n"
+                     'periodic = ["x", "y"]\n')
+        text += ('[solver]\nmethod = "sor"\ntolerance = 1e-12\nmax_iterations = 200\n'
+                 '[[material]]\nname = "glass"\n[[contact]]\nmaterials = ["glass", "glass"]\n'
+                 "mu = 0.0\neps_N = 1.0\n")
+        # The central copies first, so that their ids are 0 … 15 in both scenes.
+        for i, j in tiles:
+            for k, (c, v) in enumerate(zip(centres, velocities)):
+                x, y = c[0] + i * self.L, c[1] + j * self.L
+                text += (f'[[bodies]]\nname = "b{i}{j}_{k}"\nradius = {r}\ndensity = 2500.0\n'
+                         f'material = "glass"\nvelocity = [{v[0]!r}, {v[1]!r}, 0.0]\n'
+                         f"positions = [[{x!r}, {y!r}, 0.0]]\n")
+        text += "[output]\nevery = 1\ncontacts = true\n"
+        with open(self.path(name), "w") as f:
+            f.write(text)
+        return self.path(name)
+
+    def last(self, path, n=16):
+        with h5py.File(path, "r") as f:
+            last = f["records/%06d" % (int(f["records"].attrs["count"]) - 1)]
+            ids = last["id"][()]
+            order = np.argsort(ids)[:n]
+            self.assertTrue(np.array_equal(ids[order], np.arange(n)))
+            contacts = int(f["steps"]["contacts"].sum())
+            return last["I_r_S"][()][order], last["I_v_S"][()][order], contacts
+
+    def test_a_periodic_box_is_the_central_cell_of_the_tiled_box(self):
+        tiles = [(0, 0)] + [(i, j) for i in (-1, 0, 1) for j in (-1, 0, 1) if (i, j) != (0, 0)]
+        tiled = self.scene("tiled.toml", tiles, periodic=False)
+        self.run_ok(0, "run", tiled, "-q", "-o", self.path("t.h5"), "-c", self.path("t.c.h5"))
+        x_ref, v_ref, _ = self.last(self.path("t.h5"))
+        with h5py.File(self.path("t.h5"), "r") as f:  # central bodies touched their images' copies
+            across = sum(int(np.sum((ids.min(axis=1) < 16) & (ids.max(axis=1) >= 16)))
+                         for ids in (f["records/%06d/contacts/ids" % k][()]
+                                     for k in range(int(f["records"].attrs["count"]))))
+        self.assertGreater(across, 0, "no contact across the boundary: nothing was tested")
+        box = self.scene("box.toml", [(0, 0)], periodic=True)
+        for p in (0, 2):  # the parallel engine on one process (no mpiexec), and on two
+            out = self.path(f"p{p}.h5")
+            self.run_ok(p, "run", box, "-q", "-o", out, "-c", self.path(f"p{p}.c.h5"))
+            x, v, contacts = self.last(out)
+            self.assertGreater(contacts, 10, "the gas must collide, also across the boundary")
+            d = (x - x_ref)[:, :2]
+            d -= self.L * np.round(d / self.L)  # the same place, up to a period
+            self.assertLess(np.abs(d).max(), 1e-9, f"P = {p}")
+            # the velocities to 2.5e-7 of the speeds: what the solver's tolerance leaves of each impact,
+            # grown by the collisions that follow
+            self.assertLess(np.abs(v - v_ref).max(), 1e-7, f"P = {p}")
+            # wrapped into the box, up to what a body moves between two rebuilds of the ghosts
+            self.assertTrue(np.all((x[:, :2] > -1e-3) & (x[:, :2] < self.L + 1e-3)), x)
+
+    def test_momentum_is_conserved_across_the_periodic_boundary(self):
+        box = self.scene("box.toml", [(0, 0)], periodic=True)
+        out = self.path("m.h5")
+        self.run_ok(2, "run", box, "-q", "-o", out, "-c", self.path("m.c.h5"))
+        with h5py.File(out, "r") as f:
+            mass = f["bodies"]["mass"][()]
+            count = int(f["records"].attrs["count"])
+            p = [mass @ f["records/%06d/I_v_S" % k][()] for k in range(count)]
+            scale = mass @ np.linalg.norm(f["records/000000/I_v_S"][()], axis=1)
+        self.assertLess(np.abs(np.array(p) - p[0]).max(), 1e-13 * scale)
+
+    def test_bad_periodic_scenes_are_refused_naming_the_key(self):
+        box = self.scene("box.toml", [(0, 0)], periodic=True)
+        with open(box) as f:
+            text = f.read()
+        for wrong, expected in (('periodic = ["x", "y"]', None),
+                                ('periodic = ["x", "x"]', "distinct axis names"),
+                                ('periodic = ["w"]', "distinct axis names"),
+                                ('periodic = "x"', "distinct axis names")):
+            bad = text.replace('periodic = ["x", "y"]', wrong)
+            if expected is None:  # periodic without a domain
+                bad = "\n".join(line for line in text.splitlines()
+                                if not line.startswith("domain"))
+                expected = "the periodic box"
+            with open(self.path("bad.toml"), "w") as f:
+                f.write(bad)
+            result = grbd(0, "run", self.path("bad.toml"), "-o", self.path("bad.h5"))
+            self.assertEqual(result.returncode, 3, result.stderr)
+            self.assertIn("periodic", result.stderr)
+            self.assertIn(expected, result.stderr)
+        narrow = text.replace(f"max = [{self.L}, {self.L}, 0.01]", f"max = [0.009, {self.L}, 0.01]")
+        with open(self.path("narrow.toml"), "w") as f:
+            f.write(narrow)
+        result = grbd(0, "run", self.path("narrow.toml"), "-o", self.path("n.h5"))
+        self.assertEqual(result.returncode, 3, result.stderr)
+        self.assertIn("expected more than twice the reach of a contact", result.stderr)
+
+
 if __name__ == "__main__":
     GRBD, MPIEXEC, BALLISTIC, PILE = sys.argv[1:5]
     unittest.main(argv=sys.argv[:1] + sys.argv[5:], verbosity=2)

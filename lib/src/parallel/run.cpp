@@ -15,6 +15,7 @@
 #include <utility>
 #include <vector>
 
+#include "grbd/core/checks.hpp"
 #include "grbd/io/checkpoint.hpp"
 #include "grbd/io/output.hpp"
 #include "grbd/parallel/mpi.hpp"
@@ -213,6 +214,11 @@ std::optional<scene::SimulationState> gather_state(const Communicator& comm,
   return state;
 }
 
+// The skin of the parallel step: the scene's, or half its tolerance radius.
+double skin_of(const timestep::StepSettings& s) {
+  return s.skin > 0.0 ? s.skin : 0.5 * s.tolerance_radius;
+}
+
 double largest_radius(const scene::Scene& scene) {
   double r = 0.0;
   for (const scene::BodyGroup& g : scene.groups) r = std::max(r, scene::largest_bounding_radius(g));
@@ -229,14 +235,31 @@ Box decomposition_box(const scene::Scene& scene) {
 
 SceneDecomposition::SceneDecomposition(const Communicator& comm, const scene::Scene& scene)
     : comm_(comm),
-      grid_(decomposition_box(scene), grid_dims(comm.size(), decomposition_box(scene).sizes())),
-      parallel_{largest_radius(scene), 1} {}
+      grid_(decomposition_box(scene), grid_dims(comm.size(), decomposition_box(scene).sizes()),
+            scene.domain.periodic),
+      parallel_{largest_radius(scene), 1} {
+  // A pair of bodies must not touch both directly and through a periodic boundary: the contact
+  // keys do not tell the two contacts apart.
+  const timestep::StepSettings& s = scene.settings;
+  const double reach =
+      2.0 * parallel_.max_radius + s.contact_tolerance * s.tolerance_radius + skin_of(s);
+  const char* axes = "xyz";
+  for (int d = 0; d < 3; ++d) {
+    const double period = scene.domain.box.max[d] - scene.domain.box.min[d];
+    if (scene.domain.periodic[static_cast<std::size_t>(d)] && !(period > 2.0 * reach)) {
+      throw scene::SceneError(scene.file.string() + ": [simulation] periodic: the domain is " +
+                              format_number(period) + " m along " + axes[d] +
+                              ", expected more than twice the reach of a contact, " +
+                              format_number(2.0 * reach) + " m (two largest bodies and margins)");
+    }
+  }
+}
 
 std::unique_ptr<scene::StepEngine> SceneDecomposition::engine(
     timestep::BodySystem& system, const timestep::StaticGeometry& statics,
     const timestep::MaterialTable& materials, const timestep::StepSettings& settings) const {
   timestep::StepSettings s = settings;
-  if (s.skin == 0.0) s.skin = 0.5 * s.tolerance_radius;
+  if (s.skin == 0.0) s.skin = skin_of(s);
   return std::make_unique<ParallelStepper>(comm_, grid_, system, statics, materials, s, parallel_);
 }
 

@@ -18,11 +18,11 @@
 
 #include "grbd/body/triangle_mesh.hpp"
 #include "grbd/collision/static_mesh.hpp"
+#include "grbd/core/checks.hpp"
 #include "grbd/kinematics/exponential.hpp"
 #include "grbd/kinematics/rotation.hpp"
 #include "grbd/scene/scene.hpp"
 #include "grbd/timestep/materials.hpp"
-#include "grbd/core/checks.hpp"
 
 namespace grbd::scene {
 
@@ -50,9 +50,9 @@ void set_end_time(Scene& scene, double end_time, std::string_view source) {
                      format_number(end_time));
   }
   if (end_time / scene.settings.dt > static_cast<double>(kMaxSteps)) {
-    throw SceneError(std::string(source) + ": expected at most 10¹² steps of dt = " +
-                     format_number(scene.settings.dt) + " s, found " + format_number(end_time) +
-                     " s");
+    throw SceneError(std::string(source) +
+                     ": expected at most 10¹² steps of dt = " + format_number(scene.settings.dt) +
+                     " s, found " + format_number(end_time) + " s");
   }
   scene.end_time = end_time;
 }
@@ -65,7 +65,8 @@ double parse_real(std::string_view text, std::string_view source) {
   // it does take, and they are refused below.
   const auto [end, error] = std::from_chars(first, last, value, std::chars_format::general);
   if (text.empty() || error != std::errc() || end != last || !std::isfinite(value)) {
-    throw SceneError(std::string(source) + ": expected a decimal number such as 0.5 or 2e-3, found \"" +
+    throw SceneError(std::string(source) +
+                     ": expected a decimal number such as 0.5 or 2e-3, found \"" +
                      std::string(text) + "\"");
   }
   return value;
@@ -519,6 +520,21 @@ void read_simulation(TableReader& t, Scene& scene) {
     scene.domain.enabled = true;
     scene.domain.box = read_region(t, "domain");
   }
+  if (const toml::node* node = t.get("periodic")) {
+    const std::string expected = "an array of distinct axis names \"x\", \"y\", \"z\"";
+    const auto* axes = node->as_array();
+    if (axes == nullptr) t.fail(*node, "periodic", expected);
+    for (const toml::node& axis : *axes) {
+      const auto* name = axis.as_string();
+      const std::string_view text = name != nullptr ? std::string_view(name->get()) : "";
+      const std::size_t d = text == "x" ? 0 : text == "y" ? 1 : text == "z" ? 2 : 3;
+      if (d == 3 || scene.domain.periodic[d]) t.fail(axis, "periodic", expected);
+      scene.domain.periodic[d] = true;
+    }
+    if (scene.domain.any_periodic() && !scene.domain.enabled) {
+      t.fail(*node, "periodic", "a domain = { min, max } beside it: the periodic box");
+    }
+  }
   const double steps = scene.end_time / scene.settings.dt;
   if (steps > static_cast<double>(kMaxSteps)) {
     t.fail(*t.table().get("end_time"), "end_time", "at most 10¹² steps of dt");
@@ -583,8 +599,7 @@ void read_static(TableReader& t, Scene& scene, const std::filesystem::path& fold
       // A half-space has no orientation of its own: its normal says where it faces.
       for (const char* key : {"rotation", "orientation"}) {
         if (const toml::node* node = t.get(key)) {
-          t.fail(*node, key,
-                 "no orientation: a half-space is oriented by its normal (key normal)");
+          t.fail(*node, key, "no orientation: a half-space is oriented by its normal (key normal)");
         }
       }
       const Vector3 normal = t.vector_required("normal");
@@ -644,7 +659,8 @@ GeneratorSpec read_generator(TableReader& group, const Scene& scene, std::size_t
   const bool has_positions = group.get("positions") != nullptr;
   const toml::table* table = group.table_opt("generator");
   const char* either = "either positions = [[x, y, z], …] or a table [bodies.generator]";
-  if (!has_positions && table == nullptr) group.neither({"positions", "generator"}, "generator", either);
+  if (!has_positions && table == nullptr)
+    group.neither({"positions", "generator"}, "generator", either);
   if (has_positions && table != nullptr) {
     group.fail_at(group.table().source(), "generator", either, "both");
   }
@@ -920,6 +936,13 @@ std::string summary(const Scene& scene) {
   out << "  solver: " << contact::method_name(scene.settings.method) << ", tolerance "
       << scene.settings.solver.rel_tol << ", at most " << scene.settings.solver.max_iterations
       << " iterations" << (scene.settings.warm_start ? ", warm start" : "") << "\n";
+  if (scene.domain.any_periodic()) {
+    out << "  periodic along";
+    for (int d = 0; d < 3; ++d) {
+      if (scene.domain.periodic[static_cast<std::size_t>(d)]) out << ' ' << "xyz"[d];
+    }
+    out << " (the domain's box), on the parallel engine\n";
+  }
   out << "  materials:";
   for (const std::string& m : scene.materials) out << ' ' << m;
   out << "\n";

@@ -175,8 +175,8 @@ void Simulation::require_memory(std::uint64_t bodies, std::size_t group) const {
   const double available = available_memory();
   if (needed > available) {
     std::ostringstream out;
-    out << "generator: " << bodies << " bodies in all need about " << needed / 1e9
-        << " GB (" << kBytesPerBody << " bytes per body), more than the " << available / 1e9
+    out << "generator: " << bodies << " bodies in all need about " << needed / 1e9 << " GB ("
+        << kBytesPerBody << " bytes per body), more than the " << available / 1e9
         << " GB this process can still take; lower count or enlarge the machine";
     fail(scene_, group, out.str());
   }
@@ -198,8 +198,9 @@ void Simulation::require_invertible_constants() const {
       out << (group.shape == ShapeKind::box ? "half_extents" : "radius") << ", "
           << (group.density ? "density" : "mass") << ": a body of "
           << (group.shape == ShapeKind::box ? "this box" : "radius " + format_number(r) + " m")
-          << " and " << (group.density ? "density " + format_number(*group.density) + " kg/m³"
-                                       : "mass " + format_number(*group.mass) + " kg")
+          << " and "
+          << (group.density ? "density " + format_number(*group.density) + " kg/m³"
+                            : "mass " + format_number(*group.mass) + " kg")
           << " has the mass " << format_number(c.inertia.m) << " kg and the principal moments ("
           << format_number(c.inertia.K_Theta[0]) << ", " << format_number(c.inertia.K_Theta[1])
           << ", " << format_number(c.inertia.K_Theta[2])
@@ -300,10 +301,31 @@ class SerialEngine final : public StepEngine {
 
 Simulation::Simulation(Scene scene, const SimulationState* state, const Distribution* distribution)
     : scene_(std::move(scene)), distribution_(distribution), scratch_(std::make_unique<Scratch>()) {
+  if (scene_.domain.any_periodic() && distribution_ == nullptr) {
+    throw SceneError(scene_.file.string() +
+                     ": [simulation] periodic: a periodic scene runs on "
+                     "the parallel engine, also on one process (parallel::SceneDecomposition; "
+                     "grbd run uses it)");
+  }
   for (const std::string& name : scene_.materials) materials_.add(name);
   if (scene_.default_contact) materials_.set_default(*scene_.default_contact);
   for (const ContactSpec& c : scene_.contacts) {
     materials_.set_pair(*materials_.find(c.a), *materials_.find(c.b), c.law);
+  }
+  // The shifts of a body's periodic images (none but the body itself without periodic axes).
+  image_shifts_.assign(1, Vector3::Zero());
+  for (std::size_t d = 0; d < 3; ++d) {
+    if (!scene_.domain.periodic[d]) continue;
+    const double period =
+        scene_.domain.box.max[static_cast<int>(d)] - scene_.domain.box.min[static_cast<int>(d)];
+    const std::size_t n = image_shifts_.size();
+    for (std::size_t k = 0; k < n; ++k) {
+      for (const double sign : {-1.0, 1.0}) {
+        Vector3 shift = image_shifts_[k];
+        shift[static_cast<int>(d)] = sign * period;
+        image_shifts_.push_back(shift);
+      }
+    }
   }
   build_static();
   check_shapes();
@@ -640,10 +662,13 @@ void Simulation::inflow() {
     near.clear();
     for (std::size_t i = 0; i < system_.owned_count(); ++i) {
       const double r = system_.bounding_radii()[i];
-      const Vector3 c = system_.states()[i].q.head<3>();
       const double reach = r + r_b;
-      if ((c.array() >= lo.array() - reach).all() && (c.array() <= hi.array() + reach).all()) {
-        near.emplace_back(c.x(), c.y(), c.z(), r);
+      // The body and, in a periodic domain, its images across the periodic boundaries.
+      for (const Vector3& shift : image_shifts_) {
+        const Vector3 c = system_.states()[i].q.head<3>() + shift;
+        if ((c.array() >= lo.array() - reach).all() && (c.array() <= hi.array() + reach).all()) {
+          near.emplace_back(c.x(), c.y(), c.z(), r);
+        }
       }
     }
     if (distribution_ != nullptr) gather_near(near);
@@ -703,9 +728,16 @@ void Simulation::outlet() {
   leaving_.clear();
   const Region& box = scene_.domain.box;
   const auto states = system_.states();
+  const auto& periodic = scene_.domain.periodic;
   for (std::size_t i = 0; i < system_.owned_count(); ++i) {
-    const auto c = states[i].q.head<3>().array();
-    if ((c < box.min.array()).any() || (c > box.max.array()).any()) leaving_.push_back(i);
+    const Vector3 c = states[i].q.head<3>();
+    for (int d = 0; d < 3; ++d) {
+      // Along a periodic axis a body is wrapped, never removed.
+      if (!periodic[static_cast<std::size_t>(d)] && (c[d] < box.min[d] || c[d] > box.max[d])) {
+        leaving_.push_back(i);
+        break;
+      }
+    }
   }
   double mass = 0.0;  // of this process's leaving bodies, in a parallel run
   for (std::size_t i : leaving_)
@@ -763,8 +795,8 @@ void Simulation::restore(const SimulationState& state) {
   const double dt = scene_.settings.dt;
   if (!(std::abs(state.t / dt - static_cast<double>(state.steps)) <= 0.5)) {
     refuse("t = " + format_number(state.t) + " s and steps = " + std::to_string(state.steps) +
-           " do not fit the scene's dt = " + format_number(dt) + " s (t / dt = " +
-           format_number(state.t / dt) + ")");
+           " do not fit the scene's dt = " + format_number(dt) +
+           " s (t / dt = " + format_number(state.t / dt) + ")");
   }
   for (std::size_t g = 0; g < scene_.groups.size(); ++g) {
     const GeneratorSpec& spec = scene_.groups[g].generator;
@@ -788,8 +820,8 @@ void Simulation::restore(const SimulationState& state) {
              ", the scene has " + std::to_string(materials_.size()));
     }
     if (c.id >= next_id_) {
-      refuse("body " + std::to_string(c.id) + " has an id not below next_id = " +
-             std::to_string(next_id_));
+      refuse("body " + std::to_string(c.id) +
+             " has an id not below next_id = " + std::to_string(next_id_));
     }
     require_from_scene(c);
     if (distribution_ != nullptr && !distribution_->owns(c.state.q.head<3>())) continue;
@@ -828,14 +860,14 @@ void Simulation::require_from_scene(const BodyRecord& c) const {
       return;
     }
   }
-  throw StateError("body " + std::to_string(c.id) + " (a " +
-                   std::string(collision::kind_name(shape)) + " of radius " +
-                   format_number(radius) + " m, mass " + format_number(c.inertia.m) +
-                   " kg, moments (" + format_number(c.inertia.K_Theta[0]) + ", " +
-                   format_number(c.inertia.K_Theta[1]) + ", " +
-                   format_number(c.inertia.K_Theta[2]) + ") kg m²) is not a body that a group "
-                   "of the scene makes: no group has its shape, material, size and the mass "
-                   "and inertia its density or mass gives");
+  throw StateError(
+      "body " + std::to_string(c.id) + " (a " + std::string(collision::kind_name(shape)) +
+      " of radius " + format_number(radius) + " m, mass " + format_number(c.inertia.m) +
+      " kg, moments (" + format_number(c.inertia.K_Theta[0]) + ", " +
+      format_number(c.inertia.K_Theta[1]) + ", " + format_number(c.inertia.K_Theta[2]) +
+      ") kg m²) is not a body that a group "
+      "of the scene makes: no group has its shape, material, size and the mass "
+      "and inertia its density or mass gives");
 }
 
 }  // namespace grbd::scene

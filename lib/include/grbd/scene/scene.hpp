@@ -5,6 +5,7 @@
 /// generators, output and checkpoints), read with toml++ into a Scene and checked completely
 /// before a run starts.
 
+#include <array>
 #include <cstdint>
 #include <filesystem>
 #include <optional>
@@ -101,9 +102,10 @@ struct ContactSpec {
 
 /// Output of the run (chapter 7's HDF5 + XDMF files).
 struct OutputSpec {
-  std::filesystem::path file;  ///< the HDF5 file (empty: NAME.h5 in the working folder, NAME the scene file's stem)
-  std::uint64_t every = 100;   ///< a record every this many steps (0: none but the first and last)
-  bool float32 = false;        ///< q and u of the records in single precision
+  std::filesystem::path
+      file;  ///< the HDF5 file (empty: NAME.h5 in the working folder, NAME the scene file's stem)
+  std::uint64_t every = 100;  ///< a record every this many steps (0: none but the first and last)
+  bool float32 = false;       ///< q and u of the records in single precision
   /// Each record also holds the contacts of the step that led to it (group `contacts`: the two
   /// ids, point, normal, gap and percussions, sorted by key), drawn as lines in the XDMF.
   bool contacts = false;
@@ -119,11 +121,18 @@ struct CheckpointSpec {
 struct DomainSpec {
   bool enabled = false;  ///< without a domain no body is ever removed
   Region box;            ///< the domain [m]
+  /// Axes along which the domain is periodic (key `periodic`, chapter 8): a body leaving through
+  /// one side enters through the other, and bodies touch across the boundary; the outlet removes
+  /// bodies along the other axes only. A periodic scene runs on chapter 8's parallel engine, also
+  /// on one process.
+  std::array<bool, 3> periodic{false, false, false};
+  /// Whether some axis is periodic.
+  bool any_periodic() const { return periodic[0] || periodic[1] || periodic[2]; }
 };
 
 /// The radius of the sphere about S that holds a body of a group, at its smallest [m]: the
-/// smallest radius its distribution can give (sphere, capsule), or the box's. The scene's active-set
-/// tolerance scales the smallest over its groups (StepSettings::tolerance_radius).
+/// smallest radius its distribution can give (sphere, capsule), or the box's. The scene's
+/// active-set tolerance scales the smallest over its groups (StepSettings::tolerance_radius).
 double smallest_bounding_radius(const BodyGroup& group);
 
 /// Everything a scene file says, checked: every value in range, every material named exists,

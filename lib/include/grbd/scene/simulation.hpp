@@ -98,6 +98,8 @@ class Simulation {
   /// The same on one process of a parallel run: the system holds the bodies `distribution` says
   /// this process owns (and, while stepping, ghosts of its neighbours' bodies), and step() is
   /// collective. `distribution` must outlive the simulation; `state` may be null (a fresh run).
+  /// A scene with periodic axes needs one, also on one process (the other constructors throw
+  /// SceneError for it).
   Simulation(Scene scene, const SimulationState* state, const Distribution& distribution);
   ~Simulation();
   Simulation(const Simulation&) = delete;
@@ -170,6 +172,7 @@ class Simulation {
   double removed_mass_ = 0.0;
   std::uint64_t backlog_ = 0;
   std::vector<std::size_t> leaving_;
+  std::vector<Vector3> image_shifts_;  // of a body's periodic images, the body itself first
   std::unique_ptr<Scratch> scratch_;
 };
 
