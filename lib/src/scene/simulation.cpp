@@ -719,7 +719,7 @@ void Simulation::gather_near(std::vector<Vector4>& near) {
     const std::size_t n = part.size() / sizeof(Vector4);
     const std::size_t at = near.size();
     near.resize(at + n);
-    std::memcpy(static_cast<void*>(near.data() + at), part.data(), n * sizeof(Vector4));
+    if (n > 0) std::memcpy(static_cast<void*>(near.data() + at), part.data(), n * sizeof(Vector4));
   }
 }
 
