@@ -75,12 +75,37 @@ CartesianGrid::CartesianGrid(const Box& domain, const std::array<int, 3>& dims,
                        : domain.min()[d] + (domain.max()[d] - domain.min()[d]) * i / dims[d];
     }
   }
+  make_shifts();
+}
+
+CartesianGrid::CartesianGrid(const Box& domain, const std::array<std::vector<double>, 3>& boundaries,
+                             const std::array<bool, 3>& periodic)
+    : domain_(domain), periodic_(periodic), boundaries_(boundaries) {
+  if (!domain.min().allFinite() || !domain.max().allFinite()) {
+    throw InvalidArgument("CartesianGrid: expected a finite domain");
+  }
+  require_extent(domain.sizes(), "CartesianGrid");
+  for (int d = 0; d < 3; ++d) {
+    const std::vector<double>& b = boundaries_[d];
+    bool valid = b.size() >= 2 && b.front() == domain.min()[d] && b.back() == domain.max()[d];
+    for (std::size_t i = 1; valid && i < b.size(); ++i) valid = b[i - 1] < b[i];
+    if (!valid) {
+      throw InvalidArgument("CartesianGrid: expected boundaries along axis " + std::to_string(d) +
+                            " that increase strictly from the domain's min to its max");
+    }
+    dims_[d] = static_cast<int>(b.size()) - 1;
+  }
+  make_shifts();
+}
+
+void CartesianGrid::make_shifts() {
   shifts_.push_back({0, 0, 0});
   for (int sz = -1; sz <= 1; ++sz) {
     for (int sy = -1; sy <= 1; ++sy) {
       for (int sx = -1; sx <= 1; ++sx) {
         const bool none = sx == 0 && sy == 0 && sz == 0;
-        if (none || (sx && !periodic[0]) || (sy && !periodic[1]) || (sz && !periodic[2])) continue;
+        if (none || (sx && !periodic_[0]) || (sy && !periodic_[1]) || (sz && !periodic_[2]))
+          continue;
         shifts_.push_back({sx, sy, sz});
       }
     }

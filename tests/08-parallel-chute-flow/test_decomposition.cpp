@@ -5,8 +5,8 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
-#include <map>
 #include <cmath>
+#include <map>
 #include <random>
 #include <vector>
 
@@ -32,8 +32,8 @@ TEST(Exercise8_1, EveryPositionInTheDomainHasExactlyTheOwnerWhoseBoxHoldsIt) {
   std::mt19937_64 rng(3);
   std::uniform_real_distribution<double> u(0.0, 1.0);
   for (int k = 0; k < 20000; ++k) {
-    const Vector3 x = grid.domain().min() +
-                      Vector3(u(rng), u(rng), u(rng)).cwiseProduct(grid.domain().sizes());
+    const Vector3 x =
+        grid.domain().min() + Vector3(u(rng), u(rng), u(rng)).cwiseProduct(grid.domain().sizes());
     const int owner = grid.owner_of(x);
     ASSERT_GE(owner, 0);
     ASSERT_LT(owner, grid.size());
@@ -72,7 +72,7 @@ TEST(Exercise8_1, PeriodicAxesWrapBeforeTheOwnerIsFound) {
 
 TEST(Exercise8_2, ASphereOverlapsABoxWhenItsDistanceToTheBoxIsAtMostItsReach) {
   const Box box(Vector3(0, 0, 0), Vector3(1, 2, 3));
-  EXPECT_TRUE(overlaps(Vector3(0.5, 0.5, 0.5), 0.0, box));    // inside
+  EXPECT_TRUE(overlaps(Vector3(0.5, 0.5, 0.5), 0.0, box));     // inside
   EXPECT_TRUE(overlaps(Vector3(-0.25, 1.0, 1.0), 0.25, box));  // touching a face
   EXPECT_FALSE(overlaps(Vector3(-0.25, 1.0, 1.0), 0.2499, box));
   EXPECT_TRUE(overlaps(Vector3(-3.0, -4.0, 1.0), 5.0, box));  // touching an edge: 3-4-5
@@ -100,7 +100,7 @@ TEST(Exercise8_2, ASphereOverlapsABoxWhenItsDistanceToTheBoxIsAtMostItsReach) {
 TEST(GridDims, CutsTheDomainWhereTheInterfacesAreSmallest) {
   EXPECT_EQ(grid_dims(1, Vector3(1, 1, 1)), (std::array<int, 3>{1, 1, 1}));
   EXPECT_EQ(grid_dims(8, Vector3(1, 1, 1)), (std::array<int, 3>{2, 2, 2}));
-  EXPECT_EQ(grid_dims(7, Vector3(1, 5, 1)), (std::array<int, 3>{1, 7, 1}));  // a prime: one axis
+  EXPECT_EQ(grid_dims(7, Vector3(1, 5, 1)), (std::array<int, 3>{1, 7, 1}));     // a prime: one axis
   EXPECT_EQ(grid_dims(4, Vector3(10, 1, 0.1)), (std::array<int, 3>{4, 1, 1}));  // a chute
   // Against every factorisation: no other has smaller interfaces.
   for (int p = 1; p <= 64; ++p) {
@@ -126,7 +126,8 @@ TEST(CartesianGrid, NeighboursAreTheSubdomainsWithinReachThroughPeriodicImagesTo
   EXPECT_EQ(line.neighbours(0, 0.1), (std::vector<int>{1}));
   EXPECT_EQ(line.neighbours(1, 0.1), (std::vector<int>{0, 2}));
   EXPECT_EQ(line.neighbours(0, 1.5), (std::vector<int>{1, 2}));
-  const CartesianGrid ring(Box(Vector3(0, 0, 0), Vector3(4, 1, 1)), {4, 1, 1}, {true, false, false});
+  const CartesianGrid ring(Box(Vector3(0, 0, 0), Vector3(4, 1, 1)), {4, 1, 1},
+                           {true, false, false});
   EXPECT_EQ(ring.neighbours(0, 0.1), (std::vector<int>{1, 3}));
   const CartesianGrid one(Box(Vector3(0, 0, 0), Vector3(4, 1, 1)), {1, 1, 1}, {true, false, false});
   EXPECT_EQ(one.neighbours(0, 0.1), (std::vector<int>{0}));  // its own image
@@ -192,7 +193,8 @@ TEST(Exercise8_3, EveryContactIsSolvedByExactlyOneProcess) {
       ++solved[keys[k]];
       const auto it = std::find(all_keys.begin(), all_keys.end(), keys[k]);
       ASSERT_NE(it, all_keys.end());
-      const timestep::DetectedContact& reference = all[static_cast<std::size_t>(it - all_keys.begin())];
+      const timestep::DetectedContact& reference =
+          all[static_cast<std::size_t>(it - all_keys.begin())];
       EXPECT_EQ(found[k].geometry.g_N, reference.geometry.g_N);
       EXPECT_EQ(found[k].geometry.I_n, reference.geometry.I_n);
     }
@@ -200,6 +202,33 @@ TEST(Exercise8_3, EveryContactIsSolvedByExactlyOneProcess) {
   EXPECT_EQ(solved.size(), all_keys.size());
   for (const auto& [key, times] : solved) {
     EXPECT_EQ(times, 1) << "contact " << key.a << "–" << key.b;
+  }
+}
+
+}  // namespace
+}  // namespace grbd::parallel
+
+namespace grbd::parallel {
+namespace {
+
+// A grid with boundaries of its own (a balanced grid's): the cells are where the boundaries say,
+// and boundaries that do not increase from the domain's min to its max are refused.
+TEST(CartesianGrid, TakesBoundariesThatIncreaseAcrossTheDomain) {
+  const Box domain(Vector3(0, 0, 0), Vector3(2, 1, 1));
+  const CartesianGrid grid(domain,
+                           {std::vector<double>{0.0, 0.1, 0.3, 2.0}, {0.0, 1.0}, {0.0, 1.0}});
+  EXPECT_EQ(grid.dims(), (std::array<int, 3>{3, 1, 1}));
+  EXPECT_EQ(grid.owner_of(Vector3(0.05, 0.5, 0.5)), 0);
+  EXPECT_EQ(grid.owner_of(Vector3(0.1, 0.5, 0.5)), 1);  // on a boundary: the cell above
+  EXPECT_EQ(grid.owner_of(Vector3(1.9, 0.5, 0.5)), 2);
+  EXPECT_EQ(grid.owner_of(Vector3(-5.0, 0.5, 0.5)), 0);  // outside: the nearest cell
+  EXPECT_DOUBLE_EQ(grid.subdomain(1).min().x(), 0.1);
+  EXPECT_DOUBLE_EQ(grid.subdomain(1).max().x(), 0.3);
+  for (const std::vector<double>& bad :
+       {std::vector<double>{0.0, 0.3, 0.3, 2.0}, std::vector<double>{0.0, 0.5, 0.3, 2.0},
+        std::vector<double>{0.1, 0.5, 2.0}, std::vector<double>{0.0, 0.5, 2.5},
+        std::vector<double>{0.0}}) {
+    EXPECT_THROW(CartesianGrid(domain, {bad, {0.0, 1.0}, {0.0, 1.0}}), InvalidArgument);
   }
 }
 

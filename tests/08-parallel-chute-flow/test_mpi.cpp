@@ -13,12 +13,13 @@
 
 #include "grbd/core/error.hpp"
 #include "grbd/core/hash.hpp"
+#include "grbd/parallel/balance.hpp"
 #include "grbd/parallel/exchange.hpp"
 #include "grbd/parallel/mpi.hpp"
 #include "grbd/parallel/stepper.hpp"
+#include "grbd/timestep/body_system.hpp"
 #include "grbd/timestep/materials.hpp"
 #include "grbd/timestep/stepper.hpp"
-#include "grbd/timestep/body_system.hpp"
 
 namespace grbd::parallel {
 namespace {
@@ -116,8 +117,9 @@ TEST(Communicator, ExchangeWithNeighboursOnARing) {
 
 // A number in [−1, 1) from a body's id and a round: the same on every process, whatever P.
 double noise(std::uint64_t id, int round, int axis) {
-  const std::uint64_t h = mix64(mix64(id * 0x9e3779b97f4a7c15ULL + static_cast<std::uint64_t>(round)) +
-                                static_cast<std::uint64_t>(axis));
+  const std::uint64_t h =
+      mix64(mix64(id * 0x9e3779b97f4a7c15ULL + static_cast<std::uint64_t>(round)) +
+            static_cast<std::uint64_t>(axis));
   return static_cast<double>(h >> 11) * 0x1.0p-52 - 1.0;
 }
 
@@ -385,6 +387,94 @@ TEST(ParallelStepper, FreeFlightAcrossSubdomainsIsTheSerialRunBitForBit) {
   EXPECT_LT(parallel.rebuilds(), 150u);  // … but not at every step
 }
 
+// Bodies crowded into one corner of the domain, all owned by one process at the start: every 5
+// steps the stepper looks at the balance and moves the grid's boundaries to the bodies' weighted
+// quantiles, and the bodies to their new owners — far beyond the neighbours. Free flight stays the
+// serial run bit for bit, no body is lost or duplicated, and the load ends balanced.
+TEST(ParallelStepper, RebalancingMovesTheBoundariesToTheBodiesAndKeepsTheSerialRun) {
+  const int p = world->size();
+  const Box domain(Vector3(0, 0, 0), Vector3(1, 1, 1));
+  const CartesianGrid grid(domain, grid_dims(p, domain.sizes()));
+  timestep::BodySystem serial;
+  timestep::BodySystem mine;
+  std::uint64_t id = 1;
+  for (int i = 0; i < 8; ++i) {
+    for (int j = 0; j < 6; ++j) {
+      for (int k = 0; k < 6; ++k, ++id) {
+        const Vector3 c(0.02 + 0.03 * i, 0.1 + 0.03 * j, 0.1 + 0.03 * k);
+        const Vector3 v = Vector3(0.5, 0.2, 0.1) +
+                          0.02 * Vector3(noise(id, 9, 0), noise(id, 9, 1), noise(id, 9, 2));
+        serial.add(sphere(id, 0.005, c, v));
+        if (grid.owner_of(c) == world->rank()) mine.add(sphere(id, 0.005, c, v));
+      }
+    }
+  }
+  const timestep::StaticGeometry statics;
+  const timestep::MaterialTable materials = glass();
+  timestep::StepSettings settings;
+  settings.dt = 2e-3;
+  settings.tolerance_radius = 0.005;
+  settings.skin = 0.004;
+  timestep::MoreauStepper reference(serial, statics, materials, settings);
+  ParallelSettings balanced{0.005};
+  balanced.rebalance_every = 5;
+  ParallelStepper parallel(*world, grid, mine, statics, materials, settings, balanced);
+  for (int step = 0; step < 60; ++step) {  // collective: no ASSERT inside, no early exit
+    reference.step();
+    parallel.step();
+  }
+  std::vector<std::uint64_t> owned{mine.owned_count()};
+  std::vector<double> most{static_cast<double>(mine.owned_count())};
+  world->sum(owned);
+  world->max(most);
+  EXPECT_EQ(owned[0], serial.size());
+  for (std::size_t i = 0; i < mine.owned_count(); ++i) {
+    const std::size_t j = serial.index_of(mine.ids()[i]);
+    ASSERT_NE(j, timestep::BodySystem::npos);
+    ASSERT_EQ(mine.states()[i].q, serial.states()[j].q) << "body " << mine.ids()[i];
+    ASSERT_EQ(mine.states()[i].u, serial.states()[j].u);
+  }
+  if (p > 1) {
+    EXPECT_GE(parallel.rebalances(), 1u);
+    // the bodies drift by less than a subdomain between two looks at the balance
+    EXPECT_LE(most[0], 1.25 * static_cast<double>(serial.size()) / p);
+    EXPECT_GT(parallel.grid().boundaries(0)[1], 0.0);
+    EXPECT_LT(parallel.grid().boundaries(0)[1], 0.5);  // moved towards the crowd
+  } else {
+    EXPECT_EQ(parallel.rebalances(), 0u);
+  }
+}
+
+// The balanced grid does not depend on how the bodies are spread over the processes: each process
+// passes a share of the same 5000 centres (weights 1 to 4) and gets the grid that one process
+// computes from all of them, bit for bit; each slab holds a quarter of the weight, to one body.
+TEST(BalancedGrid, IsTheSameForEveryDistributionOfTheBodies) {
+  const Box domain(Vector3(0, 0, 0), Vector3(2, 1, 1));
+  std::vector<Vector3> all, part;
+  std::vector<double> weights, part_weights;
+  for (std::uint64_t i = 0; i < 5000; ++i) {
+    // crowded towards x = 0: x = 2 u³
+    const double u = 0.5 * (noise(i, 11, 0) + 1.0);
+    all.emplace_back(2.0 * u * u * u, 0.5 * (noise(i, 11, 1) + 1.0), 0.5 * (noise(i, 11, 2) + 1.0));
+    weights.push_back(1.0 + static_cast<double>(i % 4));
+    if (static_cast<int>(mix64(i) % static_cast<std::uint64_t>(world->size())) == world->rank()) {
+      part.push_back(all.back());
+      part_weights.push_back(weights.back());
+    }
+  }
+  const std::array<int, 3> dims{4, 1, 1};
+  const CartesianGrid one =
+      balanced_grid(self_communicator(), domain, dims, {false, false, false}, all, weights);
+  const CartesianGrid shared =
+      balanced_grid(*world, domain, dims, {false, false, false}, part, part_weights);
+  EXPECT_EQ(one.boundaries(0), shared.boundaries(0));
+  std::array<double, 4> slab{};
+  for (std::size_t i = 0; i < all.size(); ++i)
+    slab[static_cast<std::size_t>(one.owner_of(all[i]))] += weights[i];
+  for (const double w : slab) EXPECT_NEAR(w, 12500.0 / 4.0, 4.0);
+  EXPECT_LT(one.boundaries(0)[1], 0.5);  // the crowd near x = 0 gets narrow slabs
+}
+
 // A column of four spheres on the floor, standing across the boundaries between processes (one
 // subdomain per process along z): the percussion of the k-th contact from the top is k m g Δt, as
 // in the serial step, to the solver's tolerance; the spheres whose contacts another process solves
@@ -409,8 +499,10 @@ TEST_P(ColumnAcrossBoundaries, CarriesItsWeight) {
   EXPECT_EQ(report.contacts, 4u);
   EXPECT_TRUE(report.converged);
   if (world->rank() == 0) {
-    std::printf("column of 4 spheres on %d process(es), averaged every %d sweeps: %d iterations "
-                "in the last step\n", p, average_every, report.iterations);
+    std::printf(
+        "column of 4 spheres on %d process(es), averaged every %d sweeps: %d iterations "
+        "in the last step\n",
+        p, average_every, report.iterations);
   }
   // Every process's kept contacts and percussions, gathered.
   std::vector<std::byte> bytes;
@@ -503,7 +595,8 @@ TEST(ParallelStepper, AnElasticImpactThroughThePeriodicBoundarySwapsTheVelocitie
   const CartesianGrid grid(domain, {p, 1, 1}, {true, false, false});
   timestep::BodySystem mine;
   const timestep::BodyRecord a = sphere(1, r, Vector3(0.02, 0.0, 0.0), Vector3(-1.0, 0.0, 0.0));
-  const timestep::BodyRecord b = sphere(2, r, Vector3(L - 0.0205, 0.0, 0.0), Vector3(1.0, 0.0, 0.0));
+  const timestep::BodyRecord b =
+      sphere(2, r, Vector3(L - 0.0205, 0.0, 0.0), Vector3(1.0, 0.0, 0.0));
   for (const timestep::BodyRecord& body : {a, b}) {
     if (grid.owner_of(body.state.q.head<3>()) == world->rank()) mine.add(body);
   }
@@ -589,7 +682,8 @@ TEST(ParallelStepper, ASettlingPileEndsAsTheSerialPileDoes) {
   // Both nearly at rest after 0.4 s (the last ripples hold less than 1 % of the energy).
   EXPECT_LT(b.kinetic_energy, 1e-2 * std::abs(b.potential_energy));
   EXPECT_LT(a.kinetic_energy, 1e-2 * std::abs(a.potential_energy));
-  // The same height of the heap (potential energy) to a tenth of a per cent, about as many contacts.
+  // The same height of the heap (potential energy) to a tenth of a per cent, about as many
+  // contacts.
   EXPECT_NEAR(b.potential_energy, a.potential_energy, 1e-3 * std::abs(a.potential_energy));
   EXPECT_NEAR(static_cast<double>(b.contacts), static_cast<double>(a.contacts),
               0.05 * static_cast<double>(a.contacts));
@@ -597,9 +691,10 @@ TEST(ParallelStepper, ASettlingPileEndsAsTheSerialPileDoes) {
   world->sum(owned);
   EXPECT_EQ(owned[0], serial.size());
   if (world->rank() == 0) {
-    std::printf("settled pile on %d process(es): %zu contacts (serial %zu), potential energy "
-                "%.9g J (serial %.9g J)\n", p, b.contacts, a.contacts, b.potential_energy,
-                a.potential_energy);
+    std::printf(
+        "settled pile on %d process(es): %zu contacts (serial %zu), potential energy "
+        "%.9g J (serial %.9g J)\n",
+        p, b.contacts, a.contacts, b.potential_energy, a.potential_energy);
   }
 }
 

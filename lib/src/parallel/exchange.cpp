@@ -33,9 +33,8 @@ void append_body(std::vector<std::byte>& out, const timestep::BodyRecord& record
 }
 
 timestep::BodyRecord body_at(const std::vector<std::byte>& in, std::size_t offset) {
-  return timestep::unpack(
-      std::span<const std::byte, timestep::kPackedBodyBytes>(in.data() + offset,
-                                                             timestep::kPackedBodyBytes));
+  return timestep::unpack(std::span<const std::byte, timestep::kPackedBodyBytes>(
+      in.data() + offset, timestep::kPackedBodyBytes));
 }
 
 }  // namespace
@@ -210,7 +209,8 @@ namespace {
 
 void require_layout(const timestep::BodySystem& system, std::uint64_t layout, const char* what) {
   if (system.layout_version() != layout) {
-    throw InvalidArgument(std::string("BodyExchange::") + what + ": the bodies were added, "
+    throw InvalidArgument(std::string("BodyExchange::") + what +
+                          ": the bodies were added, "
                           "removed or reordered since borders(): rebuild the ghosts (migrate, "
                           "borders) first");
   }
@@ -238,7 +238,8 @@ void BodyExchange::forward(timestep::BodySystem& system) {
     if (in_[k].size() != ghost_count_[k] * kStateBytes) {
       throw Error("BodyExchange::forward: process " + std::to_string(neighbours_[k]) + " sent " +
                   std::to_string(in_[k].size() / kStateBytes) + " states for " +
-                  std::to_string(ghost_count_[k]) + " ghosts: the processes disagree on the "
+                  std::to_string(ghost_count_[k]) +
+                  " ghosts: the processes disagree on the "
                   "ghosts (a borders() call missing on some process)");
     }
     const std::byte* at = in_[k].data();

@@ -118,9 +118,9 @@ void MpiCommunicator::broadcast(std::vector<std::byte>& bytes, int root) const {
   std::uint64_t n = bytes.size();
   check(MPI_Bcast(&n, 1, MPI_UINT64_T, root, impl_->comm), "MPI_Bcast (size)");
   bytes.resize(n);
-  check(MPI_Bcast(bytes.data(), int_count(n, "Communicator::broadcast"), MPI_BYTE, root,
-                  impl_->comm),
-        "MPI_Bcast");
+  check(
+      MPI_Bcast(bytes.data(), int_count(n, "Communicator::broadcast"), MPI_BYTE, root, impl_->comm),
+      "MPI_Bcast");
 }
 
 void MpiCommunicator::all_gather(std::span<const std::byte> mine,
@@ -198,8 +198,7 @@ void MpiCommunicator::exchange(std::span<const int> neighbours,
     check(MPI_Irecv(&sizes_in[k], 1, MPI_UINT64_T, peer, kSizeTag, impl_->comm, &requests.back()),
           "MPI_Irecv (sizes)");
     requests.emplace_back();
-    check(MPI_Isend(&sizes_out[k], 1, MPI_UINT64_T, peer, kSizeTag, impl_->comm,
-                    &requests.back()),
+    check(MPI_Isend(&sizes_out[k], 1, MPI_UINT64_T, peer, kSizeTag, impl_->comm, &requests.back()),
           "MPI_Isend (sizes)");
   }
   check(MPI_Waitall(static_cast<int>(requests.size()), requests.data(), MPI_STATUSES_IGNORE),

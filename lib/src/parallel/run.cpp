@@ -237,7 +237,7 @@ SceneDecomposition::SceneDecomposition(const Communicator& comm, const scene::Sc
     : comm_(comm),
       grid_(decomposition_box(scene), grid_dims(comm.size(), decomposition_box(scene).sizes()),
             scene.domain.periodic),
-      parallel_{largest_radius(scene), 1} {
+      parallel_{largest_radius(scene), 1, 50, 1.1} {
   // A pair of bodies must not touch both directly and through a periodic boundary: the contact
   // keys do not tell the two contacts apart.
   const timestep::StepSettings& s = scene.settings;
@@ -260,7 +260,10 @@ std::unique_ptr<scene::StepEngine> SceneDecomposition::engine(
     const timestep::MaterialTable& materials, const timestep::StepSettings& settings) const {
   timestep::StepSettings s = settings;
   if (s.skin == 0.0) s.skin = skin_of(s);
-  return std::make_unique<ParallelStepper>(comm_, grid_, system, statics, materials, s, parallel_);
+  auto engine =
+      std::make_unique<ParallelStepper>(comm_, grid_, system, statics, materials, s, parallel_);
+  engine_ = engine.get();
+  return engine;
 }
 
 io::RunResult run(const scene::Scene& scene, const io::RunOptions& options,

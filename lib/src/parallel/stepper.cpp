@@ -11,6 +11,7 @@
 
 #include "grbd/core/checks.hpp"
 #include "grbd/core/error.hpp"
+#include "grbd/parallel/balance.hpp"
 
 namespace grbd::parallel {
 
@@ -24,23 +25,32 @@ ParallelStepper::ParallelStepper(const Communicator& comm, const CartesianGrid& 
       skin_(settings.skin),
       average_every_(parallel.average_every),
       max_iterations_(settings.solver.max_iterations),
-      exchange_(comm, grid, settings.contact_tolerance * settings.tolerance_radius + settings.skin,
-                parallel.max_radius) {
+      rebalance_every_(parallel.rebalance_every),
+      imbalance_(parallel.imbalance),
+      margin_(settings.contact_tolerance * settings.tolerance_radius + settings.skin),
+      max_radius_(parallel.max_radius),
+      grid_(grid) {
+  exchange_.emplace(comm, grid_, margin_, max_radius_);
+  if (parallel.rebalance_every < 0 || !(parallel.imbalance >= 1.0)) {
+    throw InvalidArgument(
+        "ParallelStepper: expected rebalance_every >= 0 and imbalance >= 1, "
+        "found " +
+        std::to_string(parallel.rebalance_every) + " and " + std::to_string(parallel.imbalance));
+  }
   if (parallel.average_every < 1) {
     throw InvalidArgument("ParallelStepper: expected average_every >= 1, found " +
                           std::to_string(parallel.average_every));
   }
   if (!(settings.tolerance_radius > 0.0)) {
-    throw InvalidArgument("ParallelStepper: expected the tolerance radius of the scene "
-                          "(StepSettings::tolerance_radius > 0): the active set of a parallel run "
-                          "must not depend on the bodies a process holds");
+    throw InvalidArgument(
+        "ParallelStepper: expected the tolerance radius of the scene "
+        "(StepSettings::tolerance_radius > 0): the active set of a parallel run "
+        "must not depend on the bodies a process holds");
   }
   timestep::StepHooks hooks;
-  hooks.after_detection = [this](const timestep::BodySystem& s,
-                                 std::vector<timestep::DetectedContact>& contacts,
-                                 std::vector<timestep::ContactKey>& keys) {
-    select_contacts(s, contacts, keys);
-  };
+  hooks.after_detection =
+      [this](const timestep::BodySystem& s, std::vector<timestep::DetectedContact>& contacts,
+             std::vector<timestep::ContactKey>& keys) { select_contacts(s, contacts, keys); };
   hooks.after_assembly = [this](contact::CompactProblem& problem, contact::ContactSolution&) {
     split_masses(problem);
   };
@@ -68,8 +78,9 @@ ParallelStepper::~ParallelStepper() = default;
 // [parallel step]
 timestep::StepReport ParallelStepper::step() {
   if (rebuild_due()) {
-    exchange_.migrate(system_, stepper_->warm_starts());
-    exchange_.borders(system_);
+    rebalance_if_due();
+    exchange_->migrate(system_, stepper_->warm_starts());
+    exchange_->borders(system_);
     reference_.resize(system_.owned_count());
     for (std::size_t i = 0; i < reference_.size(); ++i) {
       reference_[i] = system_.states()[i].q.head<3>();
@@ -77,11 +88,48 @@ timestep::StepReport ParallelStepper::step() {
     ++rebuilds_;
     changed_ = false;
   } else {
-    exchange_.forward(system_);
+    exchange_->forward(system_);
   }
   return stepper_->step();
 }
 // [parallel step]
+
+// [rebalance]
+// At a rebuild, every rebalance_every steps: when the most loaded process carries more than
+// imbalance times the mean weight (1 per body, 1 per contact it took part in at the last step),
+// the grid becomes the balanced grid of the bodies, and every body moves to its new owner (an
+// exchange among all processes, which a rebalance may send a body to), with its warm starts.
+void ParallelStepper::rebalance_if_due() {
+  const std::uint64_t step = stepper_->steps();
+  if (rebalance_every_ == 0 || step < balanced_at_ + static_cast<std::uint64_t>(rebalance_every_))
+    return;
+  balanced_at_ = step;
+  const std::size_t n = system_.owned_count();
+  std::vector<double> weights(n, 1.0);
+  for (const timestep::DetectedContact& c : stepper_->contacts()) {
+    for (const int row : {c.row_a, c.row_b}) {
+      if (row >= 0 && static_cast<std::size_t>(row) < n)
+        weights[static_cast<std::size_t>(row)] += 1.0;
+    }
+  }
+  double mine = 0.0;
+  for (const double w : weights) mine += w;
+  std::vector<double> largest{mine}, total{mine};
+  comm_.max(largest);
+  comm_.sum(total);
+  const double mean = total[0] / comm_.size();
+  if (!(largest[0] > imbalance_ * mean)) return;
+  std::vector<Vector3> centres(n);
+  for (std::size_t i = 0; i < n; ++i) centres[i] = system_.states()[i].q.head<3>();
+  grid_ = balanced_grid(comm_, grid_.domain(), grid_.dims(), grid_.periodic(), centres, weights);
+  // Every process is a neighbour of every other for this one migration: a reach beyond the domain.
+  const double everywhere = 2.0 * grid_.domain().diagonal().norm() + margin_;
+  BodyExchange all(comm_, grid_, margin_, everywhere);
+  all.migrate(system_, stepper_->warm_starts());
+  exchange_.emplace(comm_, grid_, margin_, max_radius_);
+  ++rebalances_;
+}
+// [rebalance]
 
 // Some body of some process has moved more than half the skin since the last rebuild (the rule of
 // the candidate list).
@@ -117,13 +165,13 @@ void ParallelStepper::select_contacts(const timestep::BodySystem& system,
     }
   }
   active_.assign(copies_.begin(), copies_.end());
-  exchange_.reverse_add(system, copies_, 1);
+  exchange_->reverse_add(system, copies_, 1);
   split_owned_ = 0;
   for (std::size_t i = 0; i < system.owned_count(); ++i) {
     copies_[i] += 1.0;
     if (copies_[i] > 1.0) ++split_owned_;
   }
-  exchange_.forward_values(system, copies_, 1);
+  exchange_->forward_values(system, copies_, 1);
   any_split_ = comm_.any(split_owned_ > 0);
 }
 // [select contacts]
@@ -149,18 +197,18 @@ void ParallelStepper::average_split_velocities(std::span<Vector6> u) {
   for (std::size_t r = system_.owned_count(); r < n; ++r) {
     if (active_[r] > 0.0) Eigen::Map<Vector6>(velocities_.data() + 6 * r) = u[r];
   }
-  exchange_.reverse_add(system_, velocities_, 6);
+  exchange_->reverse_add(system_, velocities_, 6);
   // The copies share one mass M/m each: the mass-weighted mean is the plain mean, for the
   // angular velocity too (the same orientation, so the same world-frame inertia).
   for (std::size_t i = 0; i < system_.owned_count(); ++i) {
     if (copies_[i] > 1.0) {
-      const Vector6 mean = (u[i] + Eigen::Map<const Vector6>(velocities_.data() + 6 * i)) /
-                           copies_[i];
+      const Vector6 mean =
+          (u[i] + Eigen::Map<const Vector6>(velocities_.data() + 6 * i)) / copies_[i];
       u[i] = mean;
       Eigen::Map<Vector6>(velocities_.data() + 6 * i) = mean;
     }
   }
-  exchange_.forward_values(system_, velocities_, 6);
+  exchange_->forward_values(system_, velocities_, 6);
   for (std::size_t r = system_.owned_count(); r < n; ++r) {
     if (copies_[r] > 1.0) u[r] = Eigen::Map<const Vector6>(velocities_.data() + 6 * r);
   }

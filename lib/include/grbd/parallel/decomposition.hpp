@@ -35,6 +35,12 @@ class CartesianGrid {
   CartesianGrid(const Box& domain, const std::array<int, 3>& dims,
                 const std::array<bool, 3>& periodic = {false, false, false});
 
+  /// A grid with given boundaries (a balanced grid: balanced_grid()): `boundaries[d]` holds
+  /// b^d_0 … b^d_{n_d}, strictly increasing, the first and last the domain's. Throws
+  /// InvalidArgument for an empty or non-finite domain or boundaries that are not such.
+  CartesianGrid(const Box& domain, const std::array<std::vector<double>, 3>& boundaries,
+                const std::array<bool, 3>& periodic = {false, false, false});
+
   /// Number of subdomains (= processes).
   int size() const { return dims_[0] * dims_[1] * dims_[2]; }
   /// Subdomains along x, y, z.
@@ -83,6 +89,7 @@ class CartesianGrid {
   std::array<bool, 3> periodic_;
   std::array<std::vector<double>, 3> boundaries_;
   std::vector<std::array<int, 3>> shifts_;
+  void make_shifts();
 };
 
 // [overlaps]

@@ -85,10 +85,10 @@ class BodyExchange {
   double margin_;
   double max_radius_;
   std::vector<int> neighbours_;
-  std::vector<Sent> sent_;                           // per neighbour, from the last borders()
+  std::vector<Sent> sent_;                              // per neighbour, from the last borders()
   std::vector<std::size_t> ghost_start_, ghost_count_;  // per neighbour: rows received
-  std::uint64_t layout_ = ~std::uint64_t{0};           // the system's layout after borders()
-  std::vector<std::vector<std::byte>> out_, in_;       // message buffers, kept
+  std::uint64_t layout_ = ~std::uint64_t{0};            // the system's layout after borders()
+  std::vector<std::vector<std::byte>> out_, in_;        // message buffers, kept
   std::vector<std::pair<timestep::GlobalId, std::size_t>> leaving_;  // id, neighbour (migrate)
 };
 

@@ -22,9 +22,10 @@ Box decomposition_box(const scene::Scene& scene);
 
 /// A scene shared by the processes of a communicator: a CartesianGrid over decomposition_box()
 /// with grid_dims() subdomains, each process owning the bodies whose centre lies in its own, and
-/// a ParallelStepper for each. Its step settings are the scene's, with a skin of half the scene's
-/// tolerance radius when the scene gives none (the ghosts and the candidate pairs are rebuilt
-/// when a body has moved a quarter of the smallest radius).
+/// a ParallelStepper for each, which looks at the balance every 50 steps and rebalances the grid
+/// when a process carries more than 1.1 times the mean load. Its step settings are the scene's,
+/// with a skin of half the scene's tolerance radius when the scene gives none (the ghosts and the
+/// candidate pairs are rebuilt when a body has moved a quarter of the smallest radius).
 class SceneDecomposition final : public scene::Distribution {
  public:
   /// The grid for `comm.size()` processes over decomposition_box(scene); throws InvalidArgument
@@ -32,8 +33,11 @@ class SceneDecomposition final : public scene::Distribution {
   SceneDecomposition(const Communicator& comm, const scene::Scene& scene);
   /// The processes of the run.
   const Communicator& communicator() const override { return comm_; }
-  /// Whether the grid gives a body centred at `centre` to this process.
-  bool owns(const Vector3& centre) const override { return grid_.owner_of(centre) == comm_.rank(); }
+  /// Whether the grid gives a body centred at `centre` to this process (the engine's grid once
+  /// there is one: it may have been rebalanced since).
+  bool owns(const Vector3& centre) const override {
+    return (engine_ != nullptr ? engine_->grid() : grid_).owner_of(centre) == comm_.rank();
+  }
   /// A ParallelStepper over the grid (the scene's settings, with a skin of half the tolerance
   /// radius when they give none).
   std::unique_ptr<scene::StepEngine> engine(timestep::BodySystem& system,
@@ -49,6 +53,7 @@ class SceneDecomposition final : public scene::Distribution {
   const Communicator& comm_;
   CartesianGrid grid_;
   ParallelSettings parallel_;
+  mutable const ParallelStepper* engine_ = nullptr;  // the last engine made
 };
 
 /// io::run() on every process of `comm` (collective): the same checks, records, checkpoints and

@@ -8,6 +8,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <span>
 #include <vector>
 
@@ -29,6 +30,12 @@ struct ParallelSettings {
   /// that disagree in between; the solver stops only after a sweep that was averaged, and the last
   /// sweep it may do (max_iterations) is always averaged.
   int average_every = 1;
+  /// Look at the balance of the processes' work every this many steps (0: never), at the first
+  /// rebuild of the ghosts after it; when the most loaded process has more than `imbalance` times
+  /// the mean weight (a body weighs 1 plus its contacts of the last step), the grid is replaced by
+  /// the balanced_grid() of the bodies and every body moves to its new owner.
+  int rebalance_every = 0;
+  double imbalance = 1.1;  ///< the largest load over the mean that needs no rebalancing, ≥ 1
 };
 
 /// Moreau's step for the bodies of this process, in lock step with the other processes of the
@@ -69,11 +76,16 @@ class ParallelStepper final : public scene::StepEngine {
   void bodies_changed() override { changed_ = true; }
   /// How often the ghosts were rebuilt.
   std::uint64_t rebuilds() const { return rebuilds_; }
+  /// How often the grid was rebalanced.
+  std::uint64_t rebalances() const { return rebalances_; }
+  /// The grid of subdomains in use (the one given, or the last balanced one).
+  const CartesianGrid& grid() const { return grid_; }
   /// Bodies owned here that were split in the last step (their copies elsewhere had contacts).
   std::size_t split_bodies() const { return split_owned_; }
 
  private:
   bool rebuild_due() const;
+  void rebalance_if_due();
   void select_contacts(const timestep::BodySystem& system,
                        std::vector<timestep::DetectedContact>& contacts,
                        std::vector<timestep::ContactKey>& keys);
@@ -87,13 +99,20 @@ class ParallelStepper final : public scene::StepEngine {
   int average_every_;
   int max_iterations_;
   int sweep_ = 0;  // sweeps of the current solve (velocities_between_sweeps' k)
-  BodyExchange exchange_;
+  int rebalance_every_;
+  double imbalance_;
+  double margin_;      // of the ghosts: contact margin + skin [m]
+  double max_radius_;  // the largest bounding radius of the run [m]
+  CartesianGrid grid_;
+  std::optional<BodyExchange> exchange_;
   std::unique_ptr<timestep::MoreauStepper> stepper_;
-  std::vector<Vector3> reference_;   // owned centres at the last rebuild
-  std::vector<double> copies_;       // per row: the number of copies of its body (1: not split)
-  std::vector<double> active_;       // per row: 1 for a ghost in a kept contact
-  std::vector<double> velocities_;   // per row: 6 doubles for the averaging
+  std::vector<Vector3> reference_;  // owned centres at the last rebuild
+  std::vector<double> copies_;      // per row: the number of copies of its body (1: not split)
+  std::vector<double> active_;      // per row: 1 for a ghost in a kept contact
+  std::vector<double> velocities_;  // per row: 6 doubles for the averaging
   std::uint64_t rebuilds_ = 0;
+  std::uint64_t rebalances_ = 0;
+  std::uint64_t balanced_at_ = 0;  // the step of the last look at the balance
   std::size_t split_owned_ = 0;
   bool any_split_ = false;
   bool changed_ = false;  // bodies added or removed here since the last rebuild

@@ -1,0 +1,99 @@
+/// \file
+/// \brief A Cartesian grid balanced by weighted quantiles along each axis.
+
+#include "grbd/parallel/balance.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "grbd/core/error.hpp"
+
+namespace grbd::parallel {
+
+// [balanced grid]
+CartesianGrid balanced_grid(const Communicator& comm, const Box& domain,
+                            const std::array<int, 3>& dims, const std::array<bool, 3>& periodic,
+                            std::span<const Vector3> centres, std::span<const double> weights) {
+  if (centres.size() != weights.size()) {
+    throw InvalidArgument("balanced_grid: expected one weight per centre, found " +
+                          std::to_string(weights.size()) + " for " +
+                          std::to_string(centres.size()));
+  }
+  for (const double w : weights) {
+    if (!(w >= 0.0) || !std::isfinite(w)) {
+      throw InvalidArgument("balanced_grid: expected weights >= 0, found " + std::to_string(w));
+    }
+  }
+  const CartesianGrid even(domain, dims, periodic);  // checks domain and dims
+  // The bisection of every cut of every axis at once: [lo, hi] brackets each cut.
+  struct Cut {
+    int axis;
+    double target;  // the weight below the cut
+    double lo, hi;
+  };
+  std::vector<double> total{0.0};
+  for (const double w : weights) total[0] += w;
+  comm.sum(total);
+  std::array<std::vector<double>, 3> boundaries;
+  std::vector<Cut> cuts;
+  for (int d = 0; d < 3; ++d) boundaries[d] = even.boundaries(d);
+  if (!(total[0] > 0.0)) return even;
+  for (int d = 0; d < 3; ++d) {
+    for (int k = 1; k < dims[d]; ++k) {
+      cuts.push_back({d, total[0] * k / dims[d], domain.min()[d], domain.max()[d]});
+    }
+  }
+  // Along each axis, this process's coordinates as the grid sees them (wrapped, clamped into the
+  // domain), sorted, with the prefix sums of their weights: the weight below a cut is then one
+  // binary search, O(log n) per cut and halving.
+  std::array<std::vector<double>, 3> sorted, prefix;
+  for (int d = 0; d < 3; ++d) {
+    if (dims[d] == 1) continue;
+    std::vector<std::pair<double, double>> along(centres.size());
+    for (std::size_t i = 0; i < centres.size(); ++i) {
+      const double v = even.wrap(centres[i])[d];
+      along[i] = {std::clamp(v, domain.min()[d], domain.max()[d]), weights[i]};
+    }
+    std::sort(along.begin(), along.end());
+    sorted[d].resize(along.size());
+    prefix[d].assign(along.size() + 1, 0.0);
+    for (std::size_t i = 0; i < along.size(); ++i) {
+      sorted[d][i] = along[i].first;
+      prefix[d][i + 1] = prefix[d][i] + along[i].second;
+    }
+  }
+  std::vector<double> below(cuts.size());
+  for (int halving = 0; halving < 60; ++halving) {
+    for (std::size_t c = 0; c < cuts.size(); ++c) {
+      const auto d = static_cast<std::size_t>(cuts[c].axis);
+      const double mid = 0.5 * (cuts[c].lo + cuts[c].hi);
+      const auto n = std::lower_bound(sorted[d].begin(), sorted[d].end(), mid) - sorted[d].begin();
+      below[c] = prefix[d][static_cast<std::size_t>(n)];
+    }
+    comm.sum(below);
+    for (std::size_t c = 0; c < cuts.size(); ++c) {
+      const double mid = 0.5 * (cuts[c].lo + cuts[c].hi);
+      (below[c] < cuts[c].target ? cuts[c].lo : cuts[c].hi) = mid;
+    }
+  }
+  std::size_t c = 0;
+  for (int d = 0; d < 3; ++d) {
+    std::vector<double>& b = boundaries[d];
+    const double gap = 1e-9 * (domain.max()[d] - domain.min()[d]);
+    for (int k = 1; k < dims[d]; ++k, ++c) {
+      b[static_cast<std::size_t>(k)] =
+          std::max(cuts[c].hi, b[static_cast<std::size_t>(k) - 1] + gap);
+    }
+    // The last cuts may have been pushed against the domain's end: keep the order there too.
+    for (int k = dims[d] - 1; k >= 1; --k) {
+      const auto i = static_cast<std::size_t>(k);
+      b[i] = std::min(b[i], b[i + 1] - gap);
+    }
+  }
+  return CartesianGrid(domain, boundaries, periodic);
+}
+// [balanced grid]
+
+}  // namespace grbd::parallel
