@@ -55,8 +55,9 @@ timestep::StepSettings settings_for(int iterations, double r) {
 
 int main(int argc, char** argv) {
   if (argc > 1 && (std::string(argv[1]) == "-h" || std::string(argv[1]) == "--help")) {
-    std::printf("usage: ch08_bench_parallel [n = 14] [iterations = 100] [steps = 10]\n"
-                "  one step of the n × n × n FCC pile on the processes of mpiexec\n");
+    std::printf(
+        "usage: ch08_bench_parallel [n = 14] [iterations = 100] [steps = 10]\n"
+        "  one step of the n × n × n FCC pile on the processes of mpiexec\n");
     return 0;
   }
   parallel::MpiEnvironment mpi;
@@ -66,8 +67,9 @@ int main(int argc, char** argv) {
   const int steps = argc > 3 ? std::atoi(argv[3]) : 10;
   const int average_every = argc > 4 ? std::atoi(argv[4]) : 1;
   if (n < 1 || iterations < 0 || steps < 1 || average_every < 1) {
-    std::fprintf(stderr, "ch08_bench_parallel: expected positive n, steps and average_every, "
-                         "and iterations >= 0\n");
+    std::fprintf(stderr,
+                 "ch08_bench_parallel: expected positive n, steps and average_every, "
+                 "and iterations >= 0\n");
     return 2;
   }
   const double r = 1e-3;
@@ -88,9 +90,12 @@ int main(int argc, char** argv) {
     parallel::ParallelStepper stepper(comm, grid, mine, statics, materials,
                                       settings_for(iterations, r), {r, average_every});
     for (int k = 0; k < 3; ++k) stepper.step();
-    std::vector<double> t(7, 0.0);  // total, midpoint, detection, assembly, solve, update, exchange
+    // total, midpoint, detection, assembly, solve, update, exchange, averaging; traffic
+    std::vector<double> t(11, 0.0);
     std::size_t contacts = 0;
     long sweeps = 0;
+    const double averaging0 = stepper.averaging_seconds();
+    const Communicator::Traffic traffic0 = comm.traffic();
     for (int k = 0; k < steps; ++k) {
       const auto t0 = Clock::now();
       const timestep::StepReport report = stepper.step();
@@ -105,6 +110,10 @@ int main(int argc, char** argv) {
       contacts = report.contacts;
       sweeps += report.iterations;
     }
+    t[7] = stepper.averaging_seconds() - averaging0;
+    t[8] = static_cast<double>(comm.traffic().messages - traffic0.messages);
+    t[9] = static_cast<double>(comm.traffic().bytes - traffic0.bytes);
+    t[10] = static_cast<double>(comm.traffic().collectives - traffic0.collectives);
     comm.max(t);
     std::vector<std::uint64_t> counts{stepper.split_bodies(), mine.ghost_count()};
     comm.sum(counts);
@@ -118,15 +127,16 @@ int main(int argc, char** argv) {
     }
     if (comm.rank() == 0) {
       const double ms = 1e3 / steps;
-      std::printf("ch08_bench_parallel: P = %d, %zu spheres, %zu contacts, %.1f sweeps a step "
-                  "(averaged every %d): step %.1f ms "
-                  "(midpoint %.1f, detection %.1f, assembly %.1f, solve %.1f, update %.1f, ghost "
-                  "exchange %.1f), %llu split bodies, %llu ghosts",
-                  comm.size(), whole.size(), contacts,
-                  static_cast<double>(sweeps) / steps, average_every, t[0] * ms, t[1] * ms,
-                  t[2] * ms, t[3] * ms, t[4] * ms, t[5] * ms, t[6] * ms,
-                  static_cast<unsigned long long>(counts[0]),
-                  static_cast<unsigned long long>(counts[1]));
+      std::printf(
+          "ch08_bench_parallel: P = %d, %zu spheres, %zu contacts, %.1f sweeps a step "
+          "(averaged every %d): step %.1f ms "
+          "(midpoint %.1f, detection %.1f, assembly %.1f, solve %.1f of which averaging "
+          "%.1f, update %.1f, ghost exchange %.1f), per step and process at most %.0f "
+          "messages, %.1f kB, %.0f collective operations; %llu split bodies, %llu ghosts",
+          comm.size(), whole.size(), contacts, static_cast<double>(sweeps) / steps, average_every,
+          t[0] * ms, t[1] * ms, t[2] * ms, t[3] * ms, t[4] * ms, t[7] * ms, t[5] * ms, t[6] * ms,
+          t[8] / steps, t[9] / steps / 1e3, t[10] / steps,
+          static_cast<unsigned long long>(counts[0]), static_cast<unsigned long long>(counts[1]));
       if (serial > 0.0) {
         std::printf("; serial MoreauStepper %.1f ms, parallel / serial %.3f", 1e3 * serial,
                     t[0] / steps / serial);

@@ -11,10 +11,10 @@
 //
 // Calibration (ch08_bench_parallel, the settled FCC pile of 97 556 spheres, 100 sweeps a step,
 // measured once by hand on two cores of one machine; chapter 8, "What it costs"): one process
-// 2529 ms a step of which 2309 ms solve; two processes 1395 ms a step with 3363 split bodies.
-// Hence c_s = 2309 ms / (100 · 97 556), c_p = (2529 − 2309) ms / 97 556, and c_i the time two
-// processes take beyond half of one, per split body and sweep (on shared memory, where α and β
-// are small). α and β of a cluster are not measured here: the demo takes 2 µs and 5 GB/s
+// 2431.0 ms a step of which 2241.8 ms solve; two processes 1381.3 ms a step with 3363 split
+// bodies. Hence c_s = 2241.8 ms / (100 · 97 556), c_p = (2431.0 − 2241.8) ms / 97 556, and c_i the
+// time two processes take beyond half of one, per split body and sweep (on shared memory, where α
+// and β are small). α and β of a cluster are not measured here: the demo takes 2 µs and 5 GB/s
 // (InfiniBand) and, for comparison, 50 µs and 0.1 GB/s (gigabit Ethernet).
 //
 // The prediction is set against GRSFramework's published run of the reference chute: 10⁶ beads
@@ -37,10 +37,10 @@ namespace {
 // The calibration: ch08_bench_parallel, 97 556 spheres, 100 sweeps a step.
 constexpr double kSpheres = 97556.0;
 constexpr double kSweeps = 100.0;
-constexpr double kStepOne = 2529e-3;   // s, one process
-constexpr double kSolveOne = 2309e-3;  // s, one process
-constexpr double kStepTwo = 1395e-3;   // s, two processes
-constexpr double kSplitTwo = 3363.0;   // split bodies, two processes
+constexpr double kStepOne = 2431.0e-3;   // s, one process
+constexpr double kSolveOne = 2241.8e-3;  // s, one process
+constexpr double kStepTwo = 1381.3e-3;   // s, two processes
+constexpr double kSplitTwo = 3363.0;     // split bodies, two processes
 
 // The reference run (GRSFramework, the reference chute).
 constexpr double kBodies = 1e6;

@@ -255,54 +255,77 @@ void BodyExchange::forward(timestep::BodySystem& system) {
 // [forward]
 
 void BodyExchange::forward_values(const timestep::BodySystem& system, std::span<double> values,
-                                  int width) {
+                                  int width, std::span<const std::uint8_t> selected) {
   require_layout(system, layout_, "forward_values");
+  const bool all = selected.empty();
   const auto w = static_cast<std::size_t>(width);
   for (std::size_t k = 0; k < neighbours_.size(); ++k) {
     std::vector<std::byte>& message = out_[k];
     message.resize(sent_[k].rows.size() * w * sizeof(double));
     std::byte* at = message.data();
     for (const std::size_t i : sent_[k].rows) {
+      if (!all && selected[i] == 0) continue;
       std::memcpy(at, values.data() + i * w, w * sizeof(double));
       at += w * sizeof(double);
     }
+    message.resize(static_cast<std::size_t>(at - message.data()));
   }
   comm_.exchange(neighbours_, out_, in_);
   for (std::size_t k = 0; k < neighbours_.size(); ++k) {
-    if (in_[k].size() != ghost_count_[k] * w * sizeof(double)) {
+    const std::byte* from = in_[k].data();
+    const std::byte* end = from + in_[k].size();
+    for (std::size_t g = ghost_start_[k]; g < ghost_start_[k] + ghost_count_[k]; ++g) {
+      if (!all && selected[g] == 0) continue;
+      if (end - from < static_cast<std::ptrdiff_t>(w * sizeof(double))) {
+        from = nullptr;  // too short
+        break;
+      }
+      std::memcpy(values.data() + g * w, from, w * sizeof(double));
+      from += w * sizeof(double);
+    }
+    if (from != end) {
       throw Error("BodyExchange::forward_values: process " + std::to_string(neighbours_[k]) +
                   " sent values for another number of ghosts");
-    }
-    if (!in_[k].empty()) {  // memcpy from an empty vector's null data() is undefined
-      std::memcpy(values.data() + ghost_start_[k] * w, in_[k].data(), in_[k].size());
     }
   }
 }
 
 // [reverse]
 void BodyExchange::reverse_add(const timestep::BodySystem& system, std::span<double> values,
-                               int width) {
+                               int width, std::span<const std::uint8_t> selected) {
   require_layout(system, layout_, "reverse_add");
+  const bool all = selected.empty();
   const auto w = static_cast<std::size_t>(width);
   for (std::size_t k = 0; k < neighbours_.size(); ++k) {
-    const std::size_t bytes = ghost_count_[k] * w * sizeof(double);
-    out_[k].resize(bytes);
-    if (bytes > 0) std::memcpy(out_[k].data(), values.data() + ghost_start_[k] * w, bytes);
+    out_[k].resize(ghost_count_[k] * w * sizeof(double));
+    std::byte* at = out_[k].data();
+    for (std::size_t g = ghost_start_[k]; g < ghost_start_[k] + ghost_count_[k]; ++g) {
+      if (!all && selected[g] == 0) continue;
+      std::memcpy(at, values.data() + g * w, w * sizeof(double));
+      at += w * sizeof(double);
+    }
+    out_[k].resize(static_cast<std::size_t>(at - out_[k].data()));
   }
   comm_.exchange(neighbours_, out_, in_);
   for (std::size_t k = 0; k < neighbours_.size(); ++k) {
-    if (in_[k].size() != sent_[k].rows.size() * w * sizeof(double)) {
-      throw Error("BodyExchange::reverse_add: process " + std::to_string(neighbours_[k]) +
-                  " sent values for another number of ghosts");
-    }
     const std::byte* from = in_[k].data();
-    for (std::size_t j = 0; j < sent_[k].rows.size(); ++j) {
-      double* to = values.data() + sent_[k].rows[j] * w;
+    const std::byte* end = from + in_[k].size();
+    for (const std::size_t i : sent_[k].rows) {
+      if (!all && selected[i] == 0) continue;
+      if (end - from < static_cast<std::ptrdiff_t>(w * sizeof(double))) {
+        from = nullptr;  // too short
+        break;
+      }
+      double* to = values.data() + i * w;
       for (std::size_t d = 0; d < w; ++d, from += sizeof(double)) {
         double x;
         std::memcpy(&x, from, sizeof x);
         to[d] += x;
       }
+    }
+    if (from != end) {
+      throw Error("BodyExchange::reverse_add: process " + std::to_string(neighbours_[k]) +
+                  " sent values for another number of ghosts");
     }
   }
 }

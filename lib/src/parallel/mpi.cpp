@@ -71,6 +71,7 @@ int MpiCommunicator::size() const { return size_; }
 
 // [rank order sum]
 void MpiCommunicator::sum(std::span<double> values) const {
+  ++traffic_.collectives;
   // Every rank's values on every rank, then added in rank order: the same bits everywhere and on
   // every run, whatever reduction tree MPI would choose.
   const int n = int_count(values.size(), "Communicator::sum");
@@ -86,24 +87,28 @@ void MpiCommunicator::sum(std::span<double> values) const {
 // [rank order sum]
 
 void MpiCommunicator::sum(std::span<std::uint64_t> values) const {
+  ++traffic_.collectives;
   check(MPI_Allreduce(MPI_IN_PLACE, values.data(), int_count(values.size(), "Communicator::sum"),
                       MPI_UINT64_T, MPI_SUM, impl_->comm),
         "MPI_Allreduce (sum)");
 }
 
 void MpiCommunicator::max(std::span<double> values) const {
+  ++traffic_.collectives;
   check(MPI_Allreduce(MPI_IN_PLACE, values.data(), int_count(values.size(), "Communicator::max"),
                       MPI_DOUBLE, MPI_MAX, impl_->comm),
         "MPI_Allreduce (max)");
 }
 
 void MpiCommunicator::min(std::span<double> values) const {
+  ++traffic_.collectives;
   check(MPI_Allreduce(MPI_IN_PLACE, values.data(), int_count(values.size(), "Communicator::min"),
                       MPI_DOUBLE, MPI_MIN, impl_->comm),
         "MPI_Allreduce (min)");
 }
 
 bool MpiCommunicator::all(bool value) const {
+  ++traffic_.collectives;
   int flag = value ? 1 : 0;
   check(MPI_Allreduce(MPI_IN_PLACE, &flag, 1, MPI_INT, MPI_LAND, impl_->comm),
         "MPI_Allreduce (all)");
@@ -111,6 +116,7 @@ bool MpiCommunicator::all(bool value) const {
 }
 
 void MpiCommunicator::broadcast(std::vector<std::byte>& bytes, int root) const {
+  ++traffic_.collectives;
   if (root < 0 || root >= size_) {
     throw InvalidArgument("Communicator::broadcast: expected a root in [0, " +
                           std::to_string(size_) + "), found " + std::to_string(root));
@@ -125,6 +131,7 @@ void MpiCommunicator::broadcast(std::vector<std::byte>& bytes, int root) const {
 
 void MpiCommunicator::all_gather(std::span<const std::byte> mine,
                                  std::vector<std::vector<std::byte>>& all) const {
+  ++traffic_.collectives;
   const int n = int_count(mine.size(), "Communicator::all_gather");
   std::vector<int> counts(static_cast<std::size_t>(size_));
   check(MPI_Allgather(&n, 1, MPI_INT, counts.data(), 1, MPI_INT, impl_->comm),
@@ -148,6 +155,7 @@ void MpiCommunicator::all_gather(std::span<const std::byte> mine,
 
 void MpiCommunicator::gather(std::span<const std::byte> mine,
                              std::vector<std::vector<std::byte>>& all, int root) const {
+  ++traffic_.collectives;
   if (root < 0 || root >= size_) {
     throw InvalidArgument("Communicator::gather: expected a root in [0, " + std::to_string(size_) +
                           "), found " + std::to_string(root));
@@ -211,6 +219,8 @@ void MpiCommunicator::exchange(std::span<const int> neighbours,
       continue;
     }
     received[k].resize(sizes_in[k]);
+    traffic_.messages += 2;  // the size and the message
+    traffic_.bytes += sizeof(std::uint64_t) + send[k].size();
     requests.emplace_back();
     check(MPI_Irecv(received[k].data(), int_count(sizes_in[k], "Communicator::exchange"), MPI_BYTE,
                     peer, kDataTag, impl_->comm, &requests.back()),
@@ -225,7 +235,10 @@ void MpiCommunicator::exchange(std::span<const int> neighbours,
 }
 // [exchange]
 
-void MpiCommunicator::barrier() const { check(MPI_Barrier(impl_->comm), "MPI_Barrier"); }
+void MpiCommunicator::barrier() const {
+  ++traffic_.collectives;
+  check(MPI_Barrier(impl_->comm), "MPI_Barrier");
+}
 
 MpiEnvironment::MpiEnvironment(bool force) {
   if (the_environment != nullptr) {

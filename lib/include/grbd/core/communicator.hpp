@@ -62,6 +62,20 @@ class Communicator {
                         std::vector<std::vector<std::byte>>& received) const = 0;
   /// Waits until every process has called it.
   virtual void barrier() const = 0;
+
+  /// What this process has sent through the communicator so far: the point-to-point messages of
+  /// exchange() (a size and a body for each neighbour that is not this process) with their bytes,
+  /// and the collective operations it took part in (reductions, broadcasts, gathers, barriers).
+  struct Traffic {
+    std::uint64_t messages = 0;     ///< point-to-point messages sent
+    std::uint64_t bytes = 0;        ///< their bytes
+    std::uint64_t collectives = 0;  ///< collective operations
+  };
+  /// The traffic so far (zero for the one-process communicator).
+  const Traffic& traffic() const { return traffic_; }
+
+ protected:
+  mutable Traffic traffic_;  ///< counted by the implementations
 };
 
 /// The communicator of a process that runs alone: rank 0 of 1, every collective operation the
@@ -88,8 +102,8 @@ class SelfCommunicator final : public Communicator {
 
 /// Throws InvalidArgument unless there is one message per neighbour and every neighbour is a rank
 /// in [0, size): the check every Communicator::exchange() makes before it sends anything.
-void require_exchange(std::span<const int> neighbours,
-                      std::span<const std::vector<std::byte>> send, int size);
+void require_exchange(std::span<const int> neighbours, std::span<const std::vector<std::byte>> send,
+                      int size);
 
 /// The one-process communicator (a process-wide instance).
 const Communicator& self_communicator();

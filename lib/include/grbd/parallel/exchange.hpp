@@ -62,11 +62,16 @@ class BodyExchange {
   /// Per-body values from the owners to their ghosts: `values` holds `width` doubles per row of
   /// the system; the rows of the ghosts are overwritten with their owners' values. The layout must
   /// be the one borders() left, as for forward().
-  void forward_values(const timestep::BodySystem& system, std::span<double> values, int width);
+  /// With `selected` (one flag per row of the system), only the rows whose flag is set take part,
+  /// on both sides: the flags of a ghost and of its owner's row must agree (forward them first).
+  void forward_values(const timestep::BodySystem& system, std::span<double> values, int width,
+                      std::span<const std::uint8_t> selected = {});
   /// Per-body values from the ghosts back to their owners, added: each owned row's values get the
   /// values of its ghosts on every process, in the order of the neighbours and of the last
   /// borders() (a reverse communication). Ghost rows are left as they are.
-  void reverse_add(const timestep::BodySystem& system, std::span<double> values, int width);
+  /// With `selected`, as for forward_values().
+  void reverse_add(const timestep::BodySystem& system, std::span<double> values, int width,
+                   std::span<const std::uint8_t> selected = {});
 
   /// Forward: the owners' current states to their ghosts (positions shifted by each ghost's
   /// image), bit for bit. The system's layout must be the one borders() left (throws

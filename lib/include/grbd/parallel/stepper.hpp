@@ -76,6 +76,8 @@ class ParallelStepper final : public scene::StepEngine {
   void bodies_changed() override { changed_ = true; }
   /// How often the ghosts were rebuilt.
   std::uint64_t rebuilds() const { return rebuilds_; }
+  /// Wall time spent so far averaging the split bodies' velocities (with its exchanges) [s].
+  double averaging_seconds() const { return averaging_seconds_; }
   /// How often the grid was rebalanced.
   std::uint64_t rebalances() const { return rebalances_; }
   /// The grid of subdomains in use (the one given, or the last balanced one).
@@ -106,12 +108,15 @@ class ParallelStepper final : public scene::StepEngine {
   CartesianGrid grid_;
   std::optional<BodyExchange> exchange_;
   std::unique_ptr<timestep::MoreauStepper> stepper_;
-  std::vector<Vector3> reference_;  // owned centres at the last rebuild
-  std::vector<double> copies_;      // per row: the number of copies of its body (1: not split)
-  std::vector<double> active_;      // per row: 1 for a ghost in a kept contact
-  std::vector<double> velocities_;  // per row: 6 doubles for the averaging
+  std::vector<Vector3> reference_;       // owned centres at the last rebuild
+  std::vector<double> copies_;           // per row: the number of copies of its body (1: not split)
+  std::vector<double> active_;           // per row: 1 for a ghost in a kept contact
+  std::vector<double> velocities_;       // per row: 6 doubles for the averaging
+  std::vector<std::uint8_t> split_;      // per row: 1 for a split body's row (owner or copy)
+  std::vector<std::size_t> split_rows_;  // those rows, ascending
   std::uint64_t rebuilds_ = 0;
   std::uint64_t rebalances_ = 0;
+  double averaging_seconds_ = 0.0;
   std::uint64_t balanced_at_ = 0;  // the step of the last look at the balance
   std::size_t split_owned_ = 0;
   bool any_split_ = false;
