@@ -84,6 +84,31 @@ TEST(Communicator, BroadcastAndAllGatherHandEveryoneTheSameBytes) {
   EXPECT_THROW(world->broadcast(b, p), InvalidArgument);
 }
 
+// The traffic counters count what this process sent: a size and a message to each neighbour that
+// is not itself, their bytes, and one collective operation per reduction or gather.
+TEST(Communicator, TrafficCountsMessagesBytesAndCollectives) {
+  const int p = world->size();
+  const int me = world->rank();
+  std::vector<int> neighbours;
+  for (int r = 0; r < p; ++r) {
+    if (r != me) neighbours.push_back(r);
+  }
+  std::vector<std::vector<std::byte>> send(neighbours.size(), std::vector<std::byte>(100 + me));
+  std::vector<std::vector<std::byte>> received;
+  const Communicator::Traffic before = world->traffic();
+  world->exchange(neighbours, send, received);
+  std::vector<double> x{1.0};
+  world->sum(x);
+  world->max(x);
+  world->all_gather(bytes_of("x"), received);
+  const Communicator::Traffic after = world->traffic();
+  const std::uint64_t others = neighbours.size();
+  EXPECT_EQ(after.messages - before.messages, 2 * others);
+  EXPECT_EQ(after.bytes - before.bytes, others * (8 + 100 + static_cast<std::uint64_t>(me)));
+  EXPECT_EQ(after.collectives - before.collectives, 3u);
+  EXPECT_EQ(self_communicator().traffic().messages, 0u);
+}
+
 TEST(Communicator, ExchangeWithNeighboursOnARing) {
   // Each rank's neighbours on a ring of p: itself at p = 1, the other at p = 2, both sides else.
   const int p = world->size();
