@@ -54,13 +54,22 @@ std::array<int, 3> grid_dims(int processes, const Vector3& extent) {
   return best;
 }
 
-CartesianGrid::CartesianGrid(const Box& domain, const std::array<int, 3>& dims,
-                             const std::array<bool, 3>& periodic)
-    : domain_(domain), dims_(dims), periodic_(periodic) {
+namespace {
+
+// A grid's domain: finite, with a positive extent along every axis.
+void require_domain(const Box& domain) {
   if (!domain.min().allFinite() || !domain.max().allFinite()) {
     throw InvalidArgument("CartesianGrid: expected a finite domain");
   }
   require_extent(domain.sizes(), "CartesianGrid");
+}
+
+}  // namespace
+
+CartesianGrid::CartesianGrid(const Box& domain, const std::array<int, 3>& dims,
+                             const std::array<bool, 3>& periodic)
+    : domain_(domain), dims_(dims), periodic_(periodic) {
+  require_domain(domain);
   for (int d = 0; d < 3; ++d) {
     if (dims[d] < 1) {
       throw InvalidArgument("CartesianGrid: expected at least one subdomain along each axis, "
@@ -81,10 +90,7 @@ CartesianGrid::CartesianGrid(const Box& domain, const std::array<int, 3>& dims,
 CartesianGrid::CartesianGrid(const Box& domain, const std::array<std::vector<double>, 3>& boundaries,
                              const std::array<bool, 3>& periodic)
     : domain_(domain), periodic_(periodic), boundaries_(boundaries) {
-  if (!domain.min().allFinite() || !domain.max().allFinite()) {
-    throw InvalidArgument("CartesianGrid: expected a finite domain");
-  }
-  require_extent(domain.sizes(), "CartesianGrid");
+  require_domain(domain);
   for (int d = 0; d < 3; ++d) {
     const std::vector<double>& b = boundaries_[d];
     bool valid = b.size() >= 2 && b.front() == domain.min()[d] && b.back() == domain.max()[d];

@@ -364,41 +364,38 @@ timestep::StepSettings resting(double r) {
   return settings;
 }
 
-// Free flight across subdomains: without contacts each body's motion is its own, and the parallel
-// step must reproduce the serial one bit for bit, wherever the body is owned.
-TEST(ParallelStepper, FreeFlightAcrossSubdomainsIsTheSerialRunBitForBit) {
-  const int p = world->size();
-  const Box domain(Vector3(0, 0, 0), Vector3(1, 1, 1));
-  const CartesianGrid grid(domain, grid_dims(p, domain.sizes()));
-  timestep::BodySystem serial;
-  timestep::BodySystem mine;
+// A flight of spheres of radius 5 mm with centres on a lattice, first at `origin`, `spacing` apart,
+// and velocities `drift` plus `spread` times a noise of their own: all of them in `serial`, those
+// this process owns in `mine`.
+void add_flight(timestep::BodySystem& serial, timestep::BodySystem& mine, const CartesianGrid& grid,
+                const std::array<int, 3>& count, const Vector3& origin, const Vector3& spacing,
+                const Vector3& drift, double spread, int round) {
   std::uint64_t id = 1;
-  for (int i = 0; i < 6; ++i) {
-    for (int j = 0; j < 6; ++j) {
-      for (int k = 0; k < 6; ++k, ++id) {
-        const Vector3 c(0.1 + 0.16 * i, 0.1 + 0.16 * j, 0.5 + 0.07 * k);
-        // A common drift (0.45 m along x in the run) and differences too small to close a gap.
-        const Vector3 v = Vector3(1.5, 1.0, 2.0) +
-                          0.05 * Vector3(noise(id, 7, 0), noise(id, 7, 1), noise(id, 7, 2));
+  for (int i = 0; i < count[0]; ++i) {
+    for (int j = 0; j < count[1]; ++j) {
+      for (int k = 0; k < count[2]; ++k, ++id) {
+        const Vector3 c = origin + Vector3(i, j, k).cwiseProduct(spacing);
+        const Vector3 v =
+            drift + spread * Vector3(noise(id, round, 0), noise(id, round, 1), noise(id, round, 2));
         serial.add(sphere(id, 0.005, c, v));
         if (grid.owner_of(c) == world->rank()) mine.add(sphere(id, 0.005, c, v));
       }
     }
   }
-  const timestep::StaticGeometry statics;
-  const timestep::MaterialTable materials = glass();
+}
+
+// Free flight, 2 ms steps, contacts measured against radius 5 mm, the given skin.
+timestep::StepSettings flight(double skin) {
   timestep::StepSettings settings;
   settings.dt = 2e-3;
   settings.tolerance_radius = 0.005;
-  settings.skin = 0.02;
-  timestep::MoreauStepper reference(serial, statics, materials, settings);
-  ParallelStepper parallel(*world, grid, mine, statics, materials, settings, {0.005});
-  std::size_t contacts = 0;
-  for (int step = 0; step < 150; ++step) {  // collective: no ASSERT inside, no early exit
-    reference.step();
-    contacts += parallel.step().contacts;
-  }
-  EXPECT_EQ(contacts, 0u);
+  settings.skin = skin;
+  return settings;
+}
+
+// Every body once over the processes, each in the state of the serial run, bit for bit.
+void expect_the_serial_bodies(const timestep::BodySystem& mine,
+                              const timestep::BodySystem& serial) {
   std::vector<std::uint64_t> owned{mine.owned_count()};
   world->sum(owned);
   EXPECT_EQ(owned[0], serial.size());
@@ -408,6 +405,30 @@ TEST(ParallelStepper, FreeFlightAcrossSubdomainsIsTheSerialRunBitForBit) {
     ASSERT_EQ(mine.states()[i].q, serial.states()[j].q) << "body " << mine.ids()[i];
     ASSERT_EQ(mine.states()[i].u, serial.states()[j].u);
   }
+}
+
+// Free flight across subdomains: without contacts each body's motion is its own, and the parallel
+// step must reproduce the serial one bit for bit, wherever the body is owned.
+TEST(ParallelStepper, FreeFlightAcrossSubdomainsIsTheSerialRunBitForBit) {
+  const int p = world->size();
+  const Box domain(Vector3(0, 0, 0), Vector3(1, 1, 1));
+  const CartesianGrid grid(domain, grid_dims(p, domain.sizes()));
+  timestep::BodySystem serial;
+  timestep::BodySystem mine;
+  // A common drift (0.45 m along x in the run) and differences too small to close a gap.
+  add_flight(serial, mine, grid, {6, 6, 6}, Vector3(0.1, 0.1, 0.5), Vector3(0.16, 0.16, 0.07),
+             Vector3(1.5, 1.0, 2.0), 0.05, 7);
+  const timestep::StaticGeometry statics;
+  const timestep::MaterialTable materials = glass();
+  timestep::MoreauStepper reference(serial, statics, materials, flight(0.02));
+  ParallelStepper parallel(*world, grid, mine, statics, materials, flight(0.02), {0.005});
+  std::size_t contacts = 0;
+  for (int step = 0; step < 150; ++step) {  // collective: no ASSERT inside, no early exit
+    reference.step();
+    contacts += parallel.step().contacts;
+  }
+  EXPECT_EQ(contacts, 0u);
+  expect_the_serial_bodies(mine, serial);
   EXPECT_GT(parallel.rebuilds(), 5u);    // the bodies moved more than half the skin, often …
   EXPECT_LT(parallel.rebuilds(), 150u);  // … but not at every step
 }
@@ -422,43 +443,21 @@ TEST(ParallelStepper, RebalancingMovesTheBoundariesToTheBodiesAndKeepsTheSerialR
   const CartesianGrid grid(domain, grid_dims(p, domain.sizes()));
   timestep::BodySystem serial;
   timestep::BodySystem mine;
-  std::uint64_t id = 1;
-  for (int i = 0; i < 8; ++i) {
-    for (int j = 0; j < 6; ++j) {
-      for (int k = 0; k < 6; ++k, ++id) {
-        const Vector3 c(0.02 + 0.03 * i, 0.1 + 0.03 * j, 0.1 + 0.03 * k);
-        const Vector3 v = Vector3(0.5, 0.2, 0.1) +
-                          0.02 * Vector3(noise(id, 9, 0), noise(id, 9, 1), noise(id, 9, 2));
-        serial.add(sphere(id, 0.005, c, v));
-        if (grid.owner_of(c) == world->rank()) mine.add(sphere(id, 0.005, c, v));
-      }
-    }
-  }
+  add_flight(serial, mine, grid, {8, 6, 6}, Vector3(0.02, 0.1, 0.1), Vector3(0.03, 0.03, 0.03),
+             Vector3(0.5, 0.2, 0.1), 0.02, 9);
   const timestep::StaticGeometry statics;
   const timestep::MaterialTable materials = glass();
-  timestep::StepSettings settings;
-  settings.dt = 2e-3;
-  settings.tolerance_radius = 0.005;
-  settings.skin = 0.004;
-  timestep::MoreauStepper reference(serial, statics, materials, settings);
+  timestep::MoreauStepper reference(serial, statics, materials, flight(0.004));
   ParallelSettings balanced{0.005};
   balanced.rebalance_every = 5;
-  ParallelStepper parallel(*world, grid, mine, statics, materials, settings, balanced);
+  ParallelStepper parallel(*world, grid, mine, statics, materials, flight(0.004), balanced);
   for (int step = 0; step < 60; ++step) {  // collective: no ASSERT inside, no early exit
     reference.step();
     parallel.step();
   }
-  std::vector<std::uint64_t> owned{mine.owned_count()};
   std::vector<double> most{static_cast<double>(mine.owned_count())};
-  world->sum(owned);
   world->max(most);
-  EXPECT_EQ(owned[0], serial.size());
-  for (std::size_t i = 0; i < mine.owned_count(); ++i) {
-    const std::size_t j = serial.index_of(mine.ids()[i]);
-    ASSERT_NE(j, timestep::BodySystem::npos);
-    ASSERT_EQ(mine.states()[i].q, serial.states()[j].q) << "body " << mine.ids()[i];
-    ASSERT_EQ(mine.states()[i].u, serial.states()[j].u);
-  }
+  expect_the_serial_bodies(mine, serial);
   if (p > 1) {
     EXPECT_GE(parallel.rebalances(), 1u);
     // the bodies drift by less than a subdomain between two looks at the balance
