@@ -2,19 +2,19 @@
 // ch08_bench_parallel, and its prediction for 10⁶ spheres on 64 to 512 cores.
 //
 // One averaged SOR sweep of a process with n = N/P bodies costs
-//   t_sweep(P) = c_s n + S(n) (c_i + b/β) + α (2 m + 2 ⌈log₂ P⌉),
+//   t_sweep(P) = c_s n + S(n) (c_i + b/β) + τ (2 n_nb + 2 ⌈log₂ P⌉),
 // the sweep over its own bodies (c_s per body), its split bodies S(n) (c_i each for their
 // averaging, and b = 96 bytes through the network: 6 doubles to the owner and back), and the
-// latency α of the 2 m messages of the reverse and forward exchanges with its m neighbours and of
-// the allreduce of the verdict. For a cubic subdomain in a dense packing S(n) = 6 n^{2/3} (one
-// layer of bodies on each face; m = 26 neighbours). A step adds c_p n for its other stages.
+// latency τ of the 2 n_nb messages of the reverse and forward exchanges with its m neighbours and
+// of the allreduce of the verdict. For a cubic subdomain in a dense packing S(n) = 6 n^{2/3} (one
+// layer of bodies on each face; n_nb = 26 neighbours). A step adds c_p n for its other stages.
 //
 // Calibration (ch08_bench_parallel, the settled FCC pile of 97 556 spheres, 100 sweeps a step,
 // measured once by hand on two cores of one machine; chapter 8, "What it costs"): one process
 // 2431.0 ms a step of which 2241.8 ms solve; two processes 1381.3 ms a step with 3363 split
 // bodies. Hence c_s = 2241.8 ms / (100 · 97 556), c_p = (2431.0 − 2241.8) ms / 97 556, and c_i the
-// time two processes take beyond half of one, per split body and sweep (on shared memory, where α
-// and β are small). α and β of a cluster are not measured here: the demo takes 2 µs and 5 GB/s
+// time two processes take beyond half of one, per split body and sweep (on shared memory, where τ
+// and β are small). τ and β of a cluster are not measured here: the demo takes 2 µs and 5 GB/s
 // (InfiniBand) and, for comparison, 50 µs and 0.1 GB/s (gigabit Ethernet).
 //
 // The prediction is set against GRSFramework's published run of the reference chute: 10⁶ beads
@@ -49,8 +49,8 @@ constexpr double kCoresReference = 384.0;
 constexpr double kSecondsReference = 12.0 * 3600.0 / 9000.0;  // s a step
 
 struct Network {
-  double alpha;  // latency [s]
-  double beta;   // bandwidth [bytes/s]
+  double tau;   // latency [s]
+  double beta;  // bandwidth [bytes/s]
 };
 constexpr Network kInfiniBand{2e-6, 5e9};
 constexpr Network kEthernet{50e-6, 0.1e9};
@@ -77,7 +77,7 @@ double step_seconds(const Constants& c, const Network& net, double N, double P, 
   const double split = P > 1.0 ? 6.0 * std::pow(n, 2.0 / 3.0) : 0.0;
   const double messages = P > 1.0 ? 2.0 * kNeighbours + 2.0 * std::ceil(std::log2(P)) : 0.0;
   const double sweep =
-      c.c_s * n + split * (c.c_i + kBytesPerSplitBody / net.beta) + net.alpha * messages;
+      c.c_s * n + split * (c.c_i + kBytesPerSplitBody / net.beta) + net.tau * messages;
   return K * sweep + c.c_p * n;
 }
 

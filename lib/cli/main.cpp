@@ -260,7 +260,9 @@ int run_command(const std::string& scene_file, const std::optional<std::string>&
   if (!quiet) {
     std::cout << (result.interrupted ? "stopped" : "done") << ": " << result.steps << " steps in "
               << std::setprecision(3) << result.seconds << " s (output and checkpoints "
-              << 100.0 * result.output_seconds / std::max(result.seconds, 1e-300) << " %), "
+              << 100.0 * result.output_seconds / std::max(result.seconds, 1e-300) << " %"
+              << (world.size() > 1 ? ", " + std::to_string(world.size()) + " processes" : "")
+              << "), "
               << result.records << " records in " << options.output.string() << ", checkpoint "
               << options.checkpoint.string() << '\n';
   }
