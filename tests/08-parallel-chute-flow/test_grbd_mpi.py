@@ -171,6 +171,28 @@ class Failures(Runs):
         serial = grbd(0, "run", scene, "-o", os.path.join(self.dir, "none", "o.h5"))
         self.assertEqual(serial.returncode, 3, serial.stderr)
 
+    def test_the_parallel_table_is_checked_and_taken(self):
+        with open(BALLISTIC) as f:
+            text = f.read()
+        for bad, key in (("rebalance_every = -1", "rebalance_every"),
+                         ("imbalance = 0.5", "imbalance"), ("average_every = 0", "average_every"),
+                         ("rebalance = 10", "unknown key")):
+            with open(self.path("bad.toml"), "w") as f:
+                f.write(text + "\n[parallel]\n" + bad + "\n")
+            result = grbd(2, "run", self.path("bad.toml"), "-o", self.path("bad.h5"), timeout=120)
+            self.assertEqual(result.returncode, 3, result.stderr)
+            self.assertEqual(result.stderr.count("grbd run:"), 1, result.stderr)
+            self.assertIn("parallel", result.stderr)
+            self.assertIn(key, result.stderr)
+        # Averaging every third sweep and never rebalancing: free flight is still the serial run.
+        with open(self.path("ok.toml"), "w") as f:
+            f.write(text + "\n[parallel]\naverage_every = 3\nrebalance_every = 0\nimbalance = 2\n")
+        self.run_ok(0, "run", self.path("ok.toml"), "-q", "-o", self.path("s.h5"), "-c",
+                    self.path("s.c.h5"))
+        self.run_ok(3, "run", self.path("ok.toml"), "-q", "-o", self.path("p.h5"), "-c",
+                    self.path("p.c.h5"))
+        self.assert_same_output(self.path("s.h5"), self.path("p.h5"))
+
     def test_sigterm_to_mpiexec_leaves_a_checkpoint_that_restarts(self):
         out, ckpt = self.path("k.h5"), self.path("k.c.h5")
         process = subprocess.Popen([MPIEXEC, "-n", "2", "--oversubscribe", "--bind-to", "none",

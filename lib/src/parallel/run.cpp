@@ -237,7 +237,8 @@ SceneDecomposition::SceneDecomposition(const Communicator& comm, const scene::Sc
     : comm_(comm),
       grid_(decomposition_box(scene), grid_dims(comm.size(), decomposition_box(scene).sizes()),
             scene.domain.periodic),
-      parallel_{largest_radius(scene), 1, 50, 1.1} {
+      parallel_{largest_radius(scene), scene.parallel.average_every, scene.parallel.rebalance_every,
+                scene.parallel.imbalance} {
   // A pair of bodies must not touch both directly and through a periodic boundary: the contact
   // keys do not tell the two contacts apart.
   const timestep::StepSettings& s = scene.settings;

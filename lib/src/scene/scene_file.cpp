@@ -758,6 +758,15 @@ void read_checkpoint(TableReader& t, Scene& scene) {
   t.finish();
 }
 
+void read_parallel(TableReader& t, Scene& scene) {
+  ParallelSpec& p = scene.parallel;
+  p.average_every = static_cast<int>(t.integer("average_every", p.average_every, 1, 1'000'000));
+  p.rebalance_every =
+      static_cast<int>(t.integer("rebalance_every", p.rebalance_every, 0, 1'000'000'000));
+  p.imbalance = t.real("imbalance", p.imbalance, Range{1.0});
+  t.finish();
+}
+
 }  // namespace
 
 Scene parse_scene(std::string_view text, const std::filesystem::path& file) {
@@ -866,6 +875,10 @@ Scene parse_scene(std::string_view text, const std::filesystem::path& file) {
   if (const toml::table* t = top.table_opt("checkpoint")) {
     TableReader reader(*t, "checkpoint", name);
     read_checkpoint(reader, scene);
+  }
+  if (const toml::table* t = top.table_opt("parallel")) {
+    TableReader reader(*t, "parallel", name);
+    read_parallel(reader, scene);
   }
   top.finish();
 

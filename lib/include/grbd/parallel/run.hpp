@@ -22,8 +22,9 @@ Box decomposition_box(const scene::Scene& scene);
 
 /// A scene shared by the processes of a communicator: a CartesianGrid over decomposition_box()
 /// with grid_dims() subdomains, each process owning the bodies whose centre lies in its own, and
-/// a ParallelStepper for each, which looks at the balance every 50 steps and rebalances the grid
-/// when a process carries more than 1.1 times the mean load. Its step settings are the scene's,
+/// a ParallelStepper for each, with the averaging and balance of the scene's `[parallel]` table
+/// (by default: average every sweep, look at the balance every 50 steps and rebalance when a
+/// process carries more than 1.1 times the mean load). Its step settings are the scene's,
 /// with a skin of half the scene's tolerance radius when the scene gives none (the ghosts and the
 /// candidate pairs are rebuilt when a body has moved a quarter of the smallest radius).
 class SceneDecomposition final : public scene::Distribution {

@@ -135,6 +135,14 @@ struct DomainSpec {
 /// active-set tolerance scales the smallest over its groups (StepSettings::tolerance_radius).
 double smallest_bounding_radius(const BodyGroup& group);
 
+/// How a run on many processes shares the work (table `[parallel]`, chapter 8); a serial run
+/// ignores it.
+struct ParallelSpec {
+  int average_every = 1;     ///< average the split bodies' velocities every this many sweeps, ≥ 1
+  int rebalance_every = 50;  ///< look at the balance every this many steps (0: never)
+  double imbalance = 1.1;    ///< the largest load over the mean that needs no rebalancing, ≥ 1
+};
+
 /// Everything a scene file says, checked: every value in range, every material named exists,
 /// every pair of materials that can meet has a law.
 struct Scene {
@@ -152,6 +160,7 @@ struct Scene {
   DomainSpec domain;                                        ///< outlet
   OutputSpec output;                                        ///< HDF5 output
   CheckpointSpec checkpoint;                                ///< checkpoints
+  ParallelSpec parallel;                                    ///< many processes (chapter 8)
   /// The number of steps of the run: round(end_time / Δt).
   std::uint64_t steps() const;
 };
