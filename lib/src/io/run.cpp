@@ -168,6 +168,20 @@ void clear_stale_stop_file(const RunOptions& options) {
   }
 }
 
+std::unique_ptr<scene::Simulation> restored_simulation(const scene::Scene& scene,
+                                                       const Checkpoint& checkpoint,
+                                                       const std::filesystem::path& restart,
+                                                       const scene::Distribution* distribution) {
+  try {
+    return distribution != nullptr
+               ? std::make_unique<scene::Simulation>(scene, &checkpoint.state, *distribution)
+               : std::make_unique<scene::Simulation>(scene, checkpoint.state);
+  } catch (const scene::StateError& e) {  // the checkpoint is at fault, not the scene
+    throw IoError(restart.string() + ": does not fit the scene " + scene.file.string() + ": " +
+                  e.what());
+  }
+}
+
 RunResult run(const scene::Scene& scene, const RunOptions& options) {
   const auto start = std::chrono::steady_clock::now();
   check_run_files(scene, options);
@@ -182,12 +196,7 @@ RunResult run(const scene::Scene& scene, const RunOptions& options) {
         !difference.empty() && options.on_warning) {
       options.on_warning(difference);
     }
-    try {
-      simulation = std::make_unique<scene::Simulation>(scene, checkpoint.state);
-    } catch (const scene::StateError& e) {  // the checkpoint is at fault, not the scene
-      throw IoError(options.restart->string() + ": does not fit the scene " + scene.file.string() +
-                    ": " + e.what());
-    }
+    simulation = restored_simulation(scene, checkpoint, *options.restart, nullptr);
     std::error_code error;
     if (std::filesystem::exists(options.output, error)) {
       output =

@@ -234,9 +234,12 @@ Box decomposition_box(const scene::Scene& scene) {
 }
 
 SceneDecomposition::SceneDecomposition(const Communicator& comm, const scene::Scene& scene)
+    : SceneDecomposition(comm, scene, decomposition_box(scene)) {}
+
+SceneDecomposition::SceneDecomposition(const Communicator& comm, const scene::Scene& scene,
+                                       const Box& box)
     : comm_(comm),
-      grid_(decomposition_box(scene), grid_dims(comm.size(), decomposition_box(scene).sizes()),
-            scene.domain.periodic),
+      grid_(box, grid_dims(comm.size(), box.sizes()), scene.domain.periodic),
       parallel_{largest_radius(scene), scene.parallel.average_every, scene.parallel.rebalance_every,
                 scene.parallel.imbalance} {
   // A pair of bodies must not touch both directly and through a periodic boundary: the contact
@@ -260,7 +263,7 @@ std::unique_ptr<scene::StepEngine> SceneDecomposition::engine(
     timestep::BodySystem& system, const timestep::StaticGeometry& statics,
     const timestep::MaterialTable& materials, const timestep::StepSettings& settings) const {
   timestep::StepSettings s = settings;
-  if (s.skin == 0.0) s.skin = skin_of(s);
+  s.skin = skin_of(s);
   auto engine =
       std::make_unique<ParallelStepper>(comm_, grid_, system, statics, materials, s, parallel_);
   engine_ = engine.get();
@@ -312,12 +315,7 @@ io::RunResult run(const scene::Scene& scene, const io::RunOptions& options,
       options.on_warning(difference);
     }
     agreed(comm, [&] {
-      try {
-        simulation = std::make_unique<scene::Simulation>(scene, &checkpoint.state, *decomposition);
-      } catch (const scene::StateError& e) {  // the checkpoint is at fault, not the scene
-        throw io::IoError(options.restart->string() + ": does not fit the scene " +
-                          scene.file.string() + ": " + e.what());
-      }
+      simulation = io::restored_simulation(scene, checkpoint, *options.restart, &*decomposition);
     });
     std::vector<std::byte> exists(1, std::byte{0});
     if (root) {

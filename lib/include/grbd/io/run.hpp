@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <functional>
+#include <memory>
 #include <optional>
 #include <string>
 
@@ -73,6 +74,14 @@ void remove_stop_file(const RunOptions& options);
 /// Removes a stop file that is there before the run starts (an earlier run was killed before it
 /// could remove it), with a warning through options.on_warning.
 void clear_stale_stop_file(const RunOptions& options);
+
+/// The simulation a restart continues: `scene` built from `checkpoint`'s state (with
+/// `distribution`, this process's part of a parallel run). Throws IoError naming `restart`, the
+/// checkpoint's file, when the state does not fit the scene (the checkpoint is at fault).
+std::unique_ptr<scene::Simulation> restored_simulation(const scene::Scene& scene,
+                                                       const Checkpoint& checkpoint,
+                                                       const std::filesystem::path& restart,
+                                                       const scene::Distribution* distribution);
 
 /// What a run did.
 struct RunResult {

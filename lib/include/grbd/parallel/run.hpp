@@ -51,6 +51,8 @@ class SceneDecomposition final : public scene::Distribution {
   const ParallelSettings& settings() const { return parallel_; }
 
  private:
+  // decomposition_box() once: it tessellates the static geometry when the scene has no outlet.
+  SceneDecomposition(const Communicator& comm, const scene::Scene& scene, const Box& box);
   const Communicator& comm_;
   CartesianGrid grid_;
   ParallelSettings parallel_;
