@@ -121,6 +121,13 @@ class BitIdentical(Runs):
                     self.assertAlmostEqual(value, attrs[key], delta=1e-13 * value)
                 else:
                     self.assertEqual(value, attrs[key], f"P = {p}: checkpoint attribute {key}")
+        # Written collectively in the global order of ids, the checkpoint is the same file whatever
+        # the number of processes: its checksum (over every row, in order) included.
+        checksums = set()
+        for p in (2, 3, 4):
+            with h5py.File(self.path(f"p{p}.c.h5"), "r") as f:
+                checksums.add(int(f.attrs["checksum"]))
+        self.assertEqual(len(checksums), 1, checksums)
 
     def test_a_run_restarted_on_4_then_2_then_1_processes_continues_bit_for_bit(self):
         reference = self.serial()
@@ -248,6 +255,99 @@ class Failures(Runs):
             with h5py.File(out, "r") as f:
                 self.assertEqual(len(f["steps"]), steps)
             self.assertLess(steps, 1000, "the run ended before the stop file: nothing was tested")
+
+
+class CollectiveFiles(Runs):
+    """Output and checkpoints written by every process together (parallel HDF5), and checkpoints
+    read in slabs: a file that does not tell how many processes wrote it, and damage found by the
+    process that reads it, reported by all."""
+
+    def pile_with_contacts(self):
+        with open(PILE) as f:
+            text = f.read()
+        self.assertIn("[output]\n", text)
+        scene = self.path("pile.toml")
+        with open(scene, "w") as f:
+            f.write(text.replace("[output]\n", "[output]\ncontacts = true\n"))
+        return scene
+
+    def test_every_process_writes_its_contacts_into_one_table_in_key_order(self):
+        scene = self.pile_with_contacts()
+        out, ckpt = self.path("c.h5"), self.path("c.c.h5")
+        self.run_ok(3, "run", scene, "-q", "-o", out, "-c", ckpt, "--end-time", "0.1")
+        with h5py.File(out, "r") as f:
+            count = int(f["records"].attrs["count"])
+            self.assertEqual(count, 6)
+            steps = f["steps"][()]
+            for k in range(count):
+                record = f[f"records/{k:06d}"]
+                ids = record["id"][()]
+                self.assertTrue(np.all(np.diff(ids.astype(np.int64)) > 0), "ids ascending, once")
+                self.assertEqual(len(ids), int(f["records/bodies"][k]))
+                contacts = record["contacts"]
+                keys = contacts["ids"][()]
+                m = int(f["records/contacts"][k])
+                self.assertEqual(len(keys), m)
+                if k > 0:  # the record's contacts are the ones its step counted
+                    self.assertEqual(m, int(steps["contacts"][int(record.attrs["step"]) - 1]))
+                order = np.lexsort((keys[:, 1], keys[:, 0]))
+                self.assertTrue(np.array_equal(order, np.arange(m)), "contacts in key order")
+                self.assertTrue(np.array_equal(contacts["line_nodes"][()].ravel(),
+                                               np.arange(2 * m)), "line nodes numbered globally")
+                self.assertEqual(contacts["line"].shape, (2 * m, 3))
+                # A line runs from side a's centre as detection saw it at the step's midpoint:
+                # half a step (0.1 ms, under 0.1 mm at these speeds) from the record's centre.
+                row = {int(i): n for n, i in enumerate(ids)}
+                centres = record["I_r_S"][()]
+                for j in range(0, m, max(1, m // 50)):
+                    a = int(keys[j, 0])
+                    if a in row:
+                        np.testing.assert_allclose(contacts["line"][2 * j], centres[row[a]],
+                                                   rtol=0, atol=1e-4)
+            self.assertGreater(int(f["records/contacts"][count - 1]), 100)
+
+    def test_a_damaged_checkpoint_is_refused_by_every_process_with_one_message(self):
+        out, ckpt = self.path("d.h5"), self.path("d.c.h5")
+        self.run_ok(2, "run", PILE, "-q", "-o", out, "-c", ckpt, "--end-time", "0.02")
+        with h5py.File(ckpt, "r+") as f:  # a bit in the last row: the last process's slab
+            states = f["states"]
+            states[len(states) - 1, 3] = np.nextafter(states[len(states) - 1, 3], 2.0)
+        result = grbd(3, "run", PILE, "-q", "-o", out, "-c", self.path("e.c.h5"), "-r", ckpt,
+                      "--end-time", "0.04")
+        self.assertNotEqual(result.returncode, 0, result.stderr)
+        self.assertEqual(result.stderr.count("is damaged"), 1, result.stderr)
+        self.assertNotIn("rank", result.stderr.split("is damaged")[0])
+        self.assertFalse(os.path.exists(self.path("e.c.h5")))
+
+    def test_a_checkpoint_of_3_processes_restarts_on_2_with_its_warm_starts(self):
+        out, ckpt = self.path("w.h5"), self.path("w.c.h5")
+        self.run_ok(3, "run", PILE, "-q", "-o", out, "-c", ckpt, "--end-time", "0.1")
+        with h5py.File(ckpt, "r") as f:
+            keys = f["warm_start_keys"][()]
+            lambdas = f["warm_start_lambda"][()]
+            ids = f["bodies"]["id"][()]
+            states = f["states"][()]
+        self.assertGreater(len(keys), 100)
+        self.assertTrue(np.all(np.diff(ids.astype(np.int64)) > 0))
+        # Restarted without a step, the checkpoint written again holds the same rows: every body
+        # and every warm start went to a process (its owner, its solver) and came back once.
+        again = self.path("w2.c.h5")
+        self.run_ok(2, "run", PILE, "-q", "-o", self.path("w2.h5"), "-c", again, "-r", ckpt,
+                    "--end-time", "0.1")
+        with h5py.File(again, "r") as f:
+            self.assertTrue(np.array_equal(f["warm_start_keys"][()], keys))
+            self.assertTrue(np.array_equal(f["warm_start_lambda"][()], lambdas))
+            self.assertTrue(np.array_equal(f["bodies"]["id"][()], ids))
+            self.assertTrue(np.array_equal(f["states"][()], states))
+        # and continued, the first step finds its contacts warm-started as the serial restart does
+        self.run_ok(2, "run", PILE, "-q", "-o", self.path("w3.h5"), "-c", self.path("w3.c.h5"),
+                    "-r", ckpt, "--end-time", "0.1002")
+        self.run_ok(0, "run", PILE, "-q", "-o", self.path("w4.h5"), "-c", self.path("w4.c.h5"),
+                    "-r", ckpt, "--end-time", "0.1002")
+        with h5py.File(self.path("w3.h5"), "r") as f3, h5py.File(self.path("w4.h5"), "r") as f4:
+            parallel, serial = f3["steps"][()][-1], f4["steps"][()][-1]
+        self.assertEqual(parallel["contacts"], serial["contacts"])
+        self.assertEqual(parallel["warm_started"], serial["warm_started"])
 
 
 class Periodic(Runs):

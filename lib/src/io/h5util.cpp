@@ -180,6 +180,10 @@ Handle create_table(hid_t location, const char* name, hid_t type, hsize_t chunk,
   Handle properties =
       check(H5Pcreate(H5P_DATASET_CREATE), H5Pclose, file, "cannot create a property list");
   check(H5Pset_chunk(properties.get(), 1, &chunk), file, "cannot set a chunk size");
+  // Chunks allocated as the table grows, not when first written: what collective writes of
+  // parallel HDF5 need (the same file content either way).
+  check(H5Pset_alloc_time(properties.get(), H5D_ALLOC_TIME_EARLY), file,
+        "cannot set the allocation time");
   return check(
       H5Dcreate2(location, name, type, space.get(), H5P_DEFAULT, properties.get(), H5P_DEFAULT),
       H5Dclose, file, std::string("cannot create dataset ") + name);
@@ -214,6 +218,59 @@ void append(hid_t dataset, hid_t memory_type, const void* data, std::uint64_t n,
         "cannot write " + name);
 }
 
+Handle shared_access(const Communicator& comm, const std::string& file) {
+  Handle access =
+      check(H5Pcreate(H5P_FILE_ACCESS), H5Pclose, file, "cannot create a property list");
+  if (comm.size() > 1 && comm.mpi_comm() != nullptr) {
+    check(H5Pset_fapl_mpio(access.get(), *static_cast<const MPI_Comm*>(comm.mpi_comm()),
+                           MPI_INFO_NULL),
+          file, "cannot set up parallel access (MPI-IO)");
+  }
+  return access;
+}
+
+Handle shared_transfer(const Communicator& comm, const std::string& file) {
+  if (comm.size() == 1 || comm.mpi_comm() == nullptr) return Handle(H5P_DEFAULT, nullptr);
+  Handle transfer =
+      check(H5Pcreate(H5P_DATASET_XFER), H5Pclose, file, "cannot create a property list");
+  check(H5Pset_dxpl_mpio(transfer.get(), H5FD_MPIO_COLLECTIVE), file,
+        "cannot set collective transfers");
+  return transfer;
+}
+
+void write_at(hid_t dataset, hid_t memory_type, std::uint64_t offset, std::uint64_t n,
+              std::uint64_t cols, const void* data, hid_t transfer, const std::string& file,
+              const std::string& name) {
+  if (n == 0 && transfer == H5P_DEFAULT) return;  // alone, nothing to write
+  Handle space = check(H5Dget_space(dataset), H5Sclose, file, "cannot read the shape of " + name);
+  const hsize_t start[2] = {offset, 0};
+  const hsize_t count[2] = {n, cols == 0 ? 1 : cols};
+  const int dims = cols == 0 ? 1 : 2;
+  Handle memory =
+      check(H5Screate_simple(dims, count, nullptr), H5Sclose, file, "cannot create a dataspace");
+  if (n == 0) {  // a process without rows takes part in the collective write with none
+    check(H5Sselect_none(space.get()), file, "cannot select rows of " + name);
+    check(H5Sselect_none(memory.get()), file, "cannot select rows of " + name);
+  } else {
+    check(H5Sselect_hyperslab(space.get(), H5S_SELECT_SET, start, nullptr, count, nullptr), file,
+          "cannot select rows of " + name);
+  }
+  check(H5Dwrite(dataset, memory_type, memory.get(), space.get(), transfer, data), file,
+        "cannot write " + name);
+}
+
+void write_rows(hid_t location, const char* name, hid_t file_type, hid_t memory_type,
+                std::uint64_t total, std::uint64_t cols, std::uint64_t offset, std::uint64_t n,
+                const void* data, hid_t transfer, const std::string& file) {
+  const hsize_t dims[2] = {total, cols};
+  Handle space = check(H5Screate_simple(cols == 0 ? 1 : 2, dims, nullptr), H5Sclose, file,
+                       "cannot create a dataspace");
+  Handle dataset = check(
+      H5Dcreate2(location, name, file_type, space.get(), H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT),
+      H5Dclose, file, std::string("cannot create dataset ") + name);
+  if (total > 0) write_at(dataset.get(), memory_type, offset, n, cols, data, transfer, file, name);
+}
+
 void write_array(hid_t location, const char* name, hid_t file_type, hid_t memory_type,
                  std::uint64_t rows, std::uint64_t cols, const void* data,
                  const std::string& file) {
@@ -229,9 +286,8 @@ void write_array(hid_t location, const char* name, hid_t file_type, hid_t memory
   }
 }
 
-template <class T>
-std::uint64_t read_array(hid_t location, const char* name, hid_t memory_type, std::int64_t rows,
-                         std::uint64_t cols, std::vector<T>& data, const std::string& file) {
+std::uint64_t rows_of(hid_t location, const char* name, hid_t memory_type, std::uint64_t cols,
+                      const std::string& file) {
   if (H5Lexists(location, name, H5P_DEFAULT) <= 0)
     fail(file, std::string("dataset ") + name + " is missing");
   Handle dataset = check(H5Dopen2(location, name, H5P_DEFAULT), H5Dclose, file,
@@ -246,26 +302,56 @@ std::uint64_t read_array(hid_t location, const char* name, hid_t memory_type, st
                    " dimension(s), found " + std::to_string(rank));
   }
   H5Sget_simple_extent_dims(space.get(), dims, nullptr);
-  if ((rows >= 0 && dims[0] != static_cast<hsize_t>(rows)) || (cols != 0 && dims[1] != cols)) {
-    fail(file, std::string("dataset ") + name + ": expected " +
-                   (rows >= 0 ? std::to_string(rows) : std::string("n")) +
-                   (cols != 0 ? " × " + std::to_string(cols) : std::string()) +
-                   " elements, found " + std::to_string(dims[0]) +
-                   (cols != 0 ? " × " + std::to_string(dims[1]) : std::string()));
+  if (cols != 0 && dims[1] != cols) {
+    fail(file, std::string("dataset ") + name + ": expected n × " + std::to_string(cols) +
+                   " elements, found " + std::to_string(dims[0]) + " × " + std::to_string(dims[1]));
   }
-  const std::uint64_t per_row = cols == 0 ? 1 : cols;
-  const std::uint64_t elements = dims[0] * per_row;
+  const std::uint64_t elements = dims[0] * (cols == 0 ? 1 : cols);
   // The file cannot hold more elements than it has bytes (a forged header must not allocate).
   const hsize_t storage = H5Dget_storage_size(dataset.get());
   if (elements > 0 && storage / H5Tget_size(memory_type) < elements / 16) {
     fail(file, std::string("dataset ") + name + " declares more elements than it stores");
   }
-  data.resize(elements);
-  if (elements > 0) {
-    check(H5Dread(dataset.get(), memory_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, data.data()), file,
-          std::string("cannot read dataset ") + name + " as the expected type");
-  }
   return dims[0];
+}
+
+template <class T>
+void read_rows(hid_t location, const char* name, hid_t memory_type, std::uint64_t total,
+               std::uint64_t cols, std::uint64_t offset, std::uint64_t n, std::vector<T>& data,
+               const std::string& file) {
+  const std::uint64_t rows = rows_of(location, name, memory_type, cols, file);
+  if (rows != total) {
+    fail(file, std::string("dataset ") + name + ": expected " + std::to_string(total) +
+                   (cols != 0 ? " × " + std::to_string(cols) : std::string()) +
+                   " elements, found " + std::to_string(rows) +
+                   (cols != 0 ? " × " + std::to_string(cols) : std::string()));
+  }
+  const std::uint64_t per_row = cols == 0 ? 1 : cols;
+  data.resize(n * per_row);
+  if (n == 0) return;
+  if (offset + n > total) fail(file, std::string("dataset ") + name + ": rows out of range");
+  Handle dataset = check(H5Dopen2(location, name, H5P_DEFAULT), H5Dclose, file,
+                         std::string("cannot open dataset ") + name);
+  Handle space = check(H5Dget_space(dataset.get()), H5Sclose, file,
+                       std::string("cannot read the shape of ") + name);
+  const hsize_t start[2] = {offset, 0};
+  const hsize_t count[2] = {n, per_row};
+  const int dims = cols == 0 ? 1 : 2;
+  check(H5Sselect_hyperslab(space.get(), H5S_SELECT_SET, start, nullptr, count, nullptr), file,
+        std::string("cannot select rows of ") + name);
+  Handle memory =
+      check(H5Screate_simple(dims, count, nullptr), H5Sclose, file, "cannot create a dataspace");
+  check(H5Dread(dataset.get(), memory_type, memory.get(), space.get(), H5P_DEFAULT, data.data()),
+        file, std::string("cannot read dataset ") + name + " as the expected type");
+}
+
+template <class T>
+std::uint64_t read_array(hid_t location, const char* name, hid_t memory_type, std::int64_t rows,
+                         std::uint64_t cols, std::vector<T>& data, const std::string& file) {
+  const std::uint64_t n = rows >= 0 ? static_cast<std::uint64_t>(rows)
+                                    : rows_of(location, name, memory_type, cols, file);
+  read_rows(location, name, memory_type, n, cols, 0, n, data, file);
+  return n;
 }
 
 template std::uint64_t read_array<double>(hid_t, const char*, hid_t, std::int64_t, std::uint64_t,
@@ -279,6 +365,16 @@ template std::uint64_t read_array<timestep::PackedBody>(hid_t, const char*, hid_
                                                         const std::string&);
 template std::uint64_t read_array<StepRow>(hid_t, const char*, hid_t, std::int64_t, std::uint64_t,
                                            std::vector<StepRow>&, const std::string&);
+template void read_rows<double>(hid_t, const char*, hid_t, std::uint64_t, std::uint64_t,
+                                std::uint64_t, std::uint64_t, std::vector<double>&,
+                                const std::string&);
+template void read_rows<std::uint64_t>(hid_t, const char*, hid_t, std::uint64_t, std::uint64_t,
+                                       std::uint64_t, std::uint64_t, std::vector<std::uint64_t>&,
+                                       const std::string&);
+template void read_rows<timestep::PackedBody>(hid_t, const char*, hid_t, std::uint64_t,
+                                              std::uint64_t, std::uint64_t, std::uint64_t,
+                                              std::vector<timestep::PackedBody>&,
+                                              const std::string&);
 
 FileLock::FileLock(const std::filesystem::path& path, bool create) {
   const std::string file = path.string();
@@ -316,7 +412,8 @@ bool locked_elsewhere(const std::filesystem::path& path) {
 }
 
 Handle locked_access(const std::string& file) {
-  Handle access = check(H5Pcreate(H5P_FILE_ACCESS), H5Pclose, file, "cannot create a property list");
+  Handle access =
+      check(H5Pcreate(H5P_FILE_ACCESS), H5Pclose, file, "cannot create a property list");
   check(H5Pset_file_locking(access.get(), false, true), file, "cannot set the file locking");
   return access;
 }

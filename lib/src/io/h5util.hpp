@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "core/hdf5.hpp"
+#include "grbd/core/communicator.hpp"
 #include "grbd/io/output.hpp"
 #include "grbd/timestep/body_record.hpp"
 
@@ -94,6 +95,23 @@ void append(hid_t dataset, hid_t memory_type, const void* data, std::uint64_t n,
 /// Sets the rows of a 1-D extendable dataset.
 void resize(hid_t dataset, std::uint64_t n, const std::string& file, const std::string& name);
 
+/// File access for the processes of `comm` together: MPI-IO (parallel HDF5) when it has an MPI
+/// communicator and more than one process, else HDF5's default.
+Handle shared_access(const Communicator& comm, const std::string& file);
+/// Transfer properties for a file opened with shared_access(): collective MPI-IO when `comm`
+/// has more than one process, else HDF5's default. Every process then takes part in each write,
+/// with its own rows or none.
+Handle shared_transfer(const Communicator& comm, const std::string& file);
+/// Writes n rows × cols of `data` at row `offset` of a dataset (cols = 0: 1-D), with the
+/// transfer properties `transfer` (n may be 0: a process without rows of a collective write).
+void write_at(hid_t dataset, hid_t memory_type, std::uint64_t offset, std::uint64_t n,
+              std::uint64_t cols, const void* data, hid_t transfer, const std::string& file,
+              const std::string& name);
+/// Creates a contiguous dataset of total × cols and writes this process's n rows at `offset`
+/// (write_at; with one process: total = n, offset 0).
+void write_rows(hid_t location, const char* name, hid_t file_type, hid_t memory_type,
+                std::uint64_t total, std::uint64_t cols, std::uint64_t offset, std::uint64_t n,
+                const void* data, hid_t transfer, const std::string& file);
 /// Writes a contiguous dataset of rows × cols (cols = 0: a 1-D dataset of `rows`).
 void write_array(hid_t location, const char* name, hid_t file_type, hid_t memory_type,
                  std::uint64_t rows, std::uint64_t cols, const void* data, const std::string& file);
@@ -103,6 +121,16 @@ template <class T>
 std::uint64_t read_array(hid_t location, const char* name, hid_t memory_type, std::int64_t rows,
                          std::uint64_t cols, std::vector<T>& data, const std::string& file);
 
+/// Reads rows [offset, offset + n) of a dataset that must be total × cols (cols = 0: 1-D) into
+/// `data`, resized to n × cols.
+template <class T>
+void read_rows(hid_t location, const char* name, hid_t memory_type, std::uint64_t total,
+               std::uint64_t cols, std::uint64_t offset, std::uint64_t n, std::vector<T>& data,
+               const std::string& file);
+/// The rows of an n × cols dataset (cols = 0: 1-D), checked against its shape and the bytes it
+/// stores, as read_array() checks them.
+std::uint64_t rows_of(hid_t location, const char* name, hid_t memory_type, std::uint64_t cols,
+                      const std::string& file);
 /// grbd's claim on an output file while it writes it: flock(LOCK_EX) on a descriptor of its own,
 /// taken before HDF5 opens (and a new output truncates) the file and held until it is closed.
 /// It is the lock HDF5 itself takes (flock), so a second grbd run, and any HDF5 program that has

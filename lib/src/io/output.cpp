@@ -14,6 +14,7 @@
 #include <type_traits>
 
 #include "grbd/version.hpp"
+#include "io/collective.hpp"
 #include "io/h5util.hpp"
 
 namespace grbd::io {
@@ -109,8 +110,9 @@ void check_bodies(hid_t root, const std::string& file, std::uint64_t rows,
       h5::fail(file, "dataset bodies, row " + std::to_string(i) + ": " + e.what());
     }
   }
-  std::sort(table.begin(), table.end(),
-            [](const timestep::BodyRecord& a, const timestep::BodyRecord& b) { return a.id < b.id; });
+  std::sort(
+      table.begin(), table.end(),
+      [](const timestep::BodyRecord& a, const timestep::BodyRecord& b) { return a.id < b.id; });
   for (const timestep::BodyRecord& body : bodies) {
     const auto it = std::lower_bound(
         table.begin(), table.end(), body.id,
@@ -141,8 +143,8 @@ std::uint64_t rows_of_three(hid_t location, const char* name, const std::string&
 // Writes the group /static: the static objects and the surface of triangles that draws them.
 StaticSurface write_static(hid_t root, const scene::Scene& scene, const std::string& file) {
   const StaticSurface surface = static_surface(scene);
-  Handle group = check(H5Gcreate2(root, "static", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT),
-                       H5Gclose, file, "cannot create group static");
+  Handle group = check(H5Gcreate2(root, "static", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Gclose,
+                       file, "cannot create group static");
   const hid_t g = group.get();
   std::vector<double> points;
   points.reserve(3 * surface.points.size());
@@ -172,13 +174,15 @@ StaticSurface write_static(hid_t root, const scene::Scene& scene, const std::str
   h5::describe(g, "object", "1", nullptr, file);
   h5::describe(g, "shape", "1", nullptr, file);
   h5::describe(g, "material", "1", nullptr, file);
-  h5::write_attribute(g, "units",
-                      std::string("points: m (frame I); triangles: rows of points, outward "
-                                  "(counter-clockwise); object: row of names; shape: 0 sphere, "
-                                  "1 box, 2 capsule, 3 half-space, 4 mesh; material: row of "
-                                  "/materials; bounds: the box (rows min, max) that cuts a half-space's plane into a "
-                                  "polygon"),
-                      file);
+  h5::write_attribute(
+      g, "units",
+      std::string(
+          "points: m (frame I); triangles: rows of points, outward "
+          "(counter-clockwise); object: row of names; shape: 0 sphere, "
+          "1 box, 2 capsule, 3 half-space, 4 mesh; material: row of "
+          "/materials; bounds: the box (rows min, max) that cuts a half-space's plane into a "
+          "polygon"),
+      file);
   // Where the half-spaces were cut: rows min and max.
   const double bounds[6] = {surface.bounds.min.x(), surface.bounds.min.y(), surface.bounds.min.z(),
                             surface.bounds.max.x(), surface.bounds.max.y(), surface.bounds.max.z()};
@@ -198,6 +202,8 @@ std::size_t first_different_line(std::string_view a, std::string_view b) {
 
 struct OutputFile::Impl {
   std::unique_ptr<h5::FileLock> lock;  // first: released after every handle is closed
+  const Communicator* comm = nullptr;  // the processes that write the file together
+  Handle transfer;                     // collective MPI-IO transfers with more than one process
   std::filesystem::path path;
   std::string file;
   bool float32 = false;
@@ -224,6 +230,14 @@ struct OutputFile::Impl {
   // The XDMF file, open to append records over its footer, which starts at xdmf_footer.
   std::fstream xdmf;
   std::streamoff xdmf_footer = 0;
+  bool root() const { return comm->rank() == 0; }
+  // Every handle of the file, innermost first.
+  void close_handles() {
+    for (Handle* h : {&record_contacts, &record_bodies, &record_step, &record_time, &records,
+                      &steps, &bodies}) {
+      h->close();
+    }
+  }
   // Scratch of a record.
   std::vector<std::uint64_t> contact_ids, line_nodes;
   std::vector<double> point, normal, gap, lambda_N, lambda_T, line;
@@ -237,20 +251,82 @@ std::filesystem::path OutputFile::xdmf_path(const std::filesystem::path& path) {
   return xdmf;
 }
 
-OutputFile::OutputFile(const std::filesystem::path& path, const scene::Scene& scene)
-{
+OutputFile::OutputFile(const std::filesystem::path& path, const scene::Scene& scene,
+                       const Communicator& comm) {
   std::lock_guard lock(hdf5::mutex());
   hdf5::QuietErrors quiet;
   impl_.reset(new Impl);  // its compound types are HDF5 objects: made under the lock
+  impl_->comm = &comm;
+  impl_->path = path;
+  impl_->file = path.string();
+  collective::agree(comm, [&] {
+    if (comm.rank() == 0) create(scene);
+  });
+  share();
+}
+
+OutputFile::OutputFile(const std::filesystem::path& path, const scene::Scene& scene,
+                       const OutputPosition& at, const RunIdentity& run, const Communicator& comm) {
+  std::lock_guard lock(hdf5::mutex());
+  hdf5::QuietErrors quiet;
+  impl_.reset(new Impl);  // its compound types are HDF5 objects: made under the lock
+  impl_->comm = &comm;
+  impl_->path = path;
+  impl_->file = path.string();
+  collective::agree(comm, [&] {
+    if (comm.rank() == 0) reopen(scene, at, run);
+  });
+  share();
+}
+
+// [share output]
+void OutputFile::share() {
   Impl& o = *impl_;
-  o.path = path;
-  o.file = path.string();
+  const Communicator& comm = *o.comm;
+  o.transfer = h5::shared_transfer(comm, o.file);
+  if (comm.size() == 1) return;
+  // Rank 0 has created or reopened the file alone (its checks, the XDMF); it closes it, keeping
+  // its lock, and every process opens it for parallel writes.
+  std::vector<std::byte> state(5 * sizeof(std::uint64_t));
+  if (o.root()) {
+    o.close_handles();
+    const bool closed = o.handle.close();
+    const std::uint64_t values[5] = {written_.records, written_.steps, written_.bodies,
+                                     std::uint64_t{o.contacts} | std::uint64_t{closed} << 1,
+                                     std::uint64_t{o.float32}};
+    std::memcpy(state.data(), values, state.size());
+  }
+  comm.broadcast(state, 0);
+  std::uint64_t values[5];
+  std::memcpy(values, state.data(), state.size());
+  written_ = {values[0], values[1], values[2]};
+  o.contacts = (values[3] & 1) != 0;
+  o.float32 = values[4] != 0;
+  if ((values[3] & 2) == 0) throw IoError(o.file + ": cannot close the output file on rank 0");
+  collective::agree(comm, [&] {
+    o.handle = check(H5Fopen(o.file.c_str(), H5F_ACC_RDWR, h5::shared_access(comm, o.file).get()),
+                     H5Fclose, o.file, "cannot open the output file on every process");
+    const hid_t root = o.handle.get();
+    o.bodies = open_dataset(root, "bodies", o.file);
+    o.steps = open_dataset(root, "steps", o.file);
+    o.records = open_group(root, "records", o.file);
+    o.record_time = open_dataset(o.records.get(), "time", o.file);
+    o.record_step = open_dataset(o.records.get(), "step", o.file);
+    o.record_bodies = open_dataset(o.records.get(), "bodies", o.file);
+    if (o.contacts) o.record_contacts = open_dataset(o.records.get(), "contacts", o.file);
+  });
+}
+// [share output]
+
+void OutputFile::create(const scene::Scene& scene) {
+  Impl& o = *impl_;
+  const std::filesystem::path& path = o.path;
   o.float32 = scene.output.float32;
   // The lock before the truncation: a file that another run writes is refused untouched.
   o.lock = std::make_unique<h5::FileLock>(path, true);
-  o.handle = check(H5Fcreate(o.file.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT,
-                             h5::locked_access(o.file).get()),
-                   H5Fclose, o.file, "cannot create the output file");
+  o.handle =
+      check(H5Fcreate(o.file.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, h5::locked_access(o.file).get()),
+            H5Fclose, o.file, "cannot create the output file");
   const hid_t root = o.handle.get();
   h5::write_attribute(root, "format", std::string("grbd output"), o.file);
   h5::write_attribute(root, "format_version", kOutputFormatVersion, o.file);
@@ -279,8 +355,7 @@ OutputFile::OutputFile(const std::filesystem::path& path, const scene::Scene& sc
   o.contacts = scene.output.contacts;
   h5::write_attribute(o.records.get(), "contacts", std::uint64_t{o.contacts ? 1u : 0u}, o.file);
   if (o.contacts) {
-    o.record_contacts =
-        h5::create_table(o.records.get(), "contacts", H5T_STD_U64LE, 256, o.file);
+    o.record_contacts = h5::create_table(o.records.get(), "contacts", H5T_STD_U64LE, 256, o.file);
     h5::describe(o.records.get(), "contacts", "1", nullptr, o.file);
   }
   h5::describe(o.records.get(), "time", "s", nullptr, o.file);
@@ -306,15 +381,10 @@ OutputFile::OutputFile(const std::filesystem::path& path, const scene::Scene& sc
   write_xdmf();
 }
 
-OutputFile::OutputFile(const std::filesystem::path& path, const scene::Scene& scene,
-                       const OutputPosition& at, const RunIdentity& run)
-{
-  std::lock_guard lock(hdf5::mutex());
-  hdf5::QuietErrors quiet;
-  impl_.reset(new Impl);  // its compound types are HDF5 objects: made under the lock
+void OutputFile::reopen(const scene::Scene& scene, const OutputPosition& at,
+                        const RunIdentity& run) {
   Impl& o = *impl_;
-  o.path = path;
-  o.file = path.string();
+  const std::filesystem::path& path = o.path;
   o.lock = std::make_unique<h5::FileLock>(path, false);
   o.handle = open_output(path, H5F_ACC_RDWR, h5::locked_access(o.file).get());
   const hid_t root = o.handle.get();
@@ -370,8 +440,9 @@ OutputFile::OutputFile(const std::filesystem::path& path, const scene::Scene& sc
   h5::resize(o.record_bodies.get(), at.records, o.file, "records/bodies");
   if (o.contacts) {
     if (h5::rows(o.record_contacts.get(), o.file, "records/contacts") < at.records) {
-      h5::fail(o.file, "holds less than the checkpoint counts in records/contacts: it is not "
-                       "this run's output");
+      h5::fail(o.file,
+               "holds less than the checkpoint counts in records/contacts: it is not "
+               "this run's output");
     }
     h5::resize(o.record_contacts.get(), at.records, o.file, "records/contacts");
     h5::read_array(o.records.get(), "contacts", H5T_NATIVE_UINT64,
@@ -426,23 +497,32 @@ void OutputFile::add_step(const timestep::StepReport& report, std::size_t bodies
 
 void OutputFile::write_bodies(std::vector<timestep::BodyRecord>& created) {
   Impl& o = *impl_;
-  if (created.empty()) return;
-  // In creation order, which is the order of ids (a parallel run gathers them from its processes).
-  std::sort(
-      created.begin(), created.end(),
-      [](const timestep::BodyRecord& a, const timestep::BodyRecord& b) { return a.id < b.id; });
+  // In the order of ids, which is the order of creation, whichever process created them.
   h5::pack_rows(created, o.packed_bodies);
-  const auto& rows = o.packed_bodies;
-  h5::append(o.bodies.get(), o.body_type.get(), rows.data(), rows.size(), o.file, "bodies");
-  written_.bodies += rows.size();
   created.clear();
+  auto& rows = o.packed_bodies;
+  const collective::Block block =
+      collective::sort_across(*o.comm, rows, [](const timestep::PackedBody& row) {
+        std::uint64_t id = 0;
+        std::memcpy(&id, row.data() + timestep::packed::id, sizeof id);
+        return id;
+      });
+  if (block.total == 0) return;
+  h5::resize(o.bodies.get(), written_.bodies + block.total, o.file, "bodies");
+  h5::write_at(o.bodies.get(), o.body_type.get(), written_.bodies + block.offset, rows.size(), 0,
+               rows.data(), o.transfer.get(), o.file, "bodies");
+  written_.bodies += block.total;
 }
 
 void OutputFile::write_steps() {
   Impl& o = *impl_;
-  h5::append(o.steps.get(), o.step_type.get(), o.pending_steps.data(), o.pending_steps.size(),
-             o.file, "steps");
-  written_.steps += o.pending_steps.size();
+  // Every process has added the same steps; rank 0's rows are written.
+  const std::uint64_t n = o.pending_steps.size();
+  if (n == 0) return;
+  h5::resize(o.steps.get(), written_.steps + n, o.file, "steps");
+  h5::write_at(o.steps.get(), o.step_type.get(), written_.steps, o.root() ? n : 0, 0,
+               o.pending_steps.data(), o.transfer.get(), o.file, "steps");
+  written_.steps += n;
   o.pending_steps.clear();
 }
 
@@ -511,29 +591,20 @@ void collect_record(scene::Simulation& simulation, bool contacts, RecordPart& pa
 void OutputFile::write_record(scene::Simulation& simulation) {
   RecordPart part;
   collect_record(simulation, impl_->contacts, part);
-  write_record(simulation.stepper().time(), simulation.stepper().steps(), std::span(&part, 1));
+  write_record(simulation.stepper().time(), simulation.stepper().steps(), part);
 }
 
-void OutputFile::write_record(double t, std::uint64_t step, std::span<RecordPart> parts) {
+// [write record]
+void OutputFile::write_record(double t, std::uint64_t step, RecordPart& part) {
   std::lock_guard lock(hdf5::mutex());
   hdf5::QuietErrors quiet;
   Impl& o = *impl_;
-  {
-    std::vector<timestep::BodyRecord>& created = parts.front().created;
-    for (std::size_t k = 1; k < parts.size(); ++k) {
-      created.insert(created.end(), parts[k].created.begin(), parts[k].created.end());
-      parts[k].created.clear();
-    }
-    write_bodies(created);
-  }
+  write_bodies(part.created);
   write_steps();
-
-  std::vector<RecordBody>& bodies = parts.front().bodies;
-  for (std::size_t k = 1; k < parts.size(); ++k) {
-    bodies.insert(bodies.end(), parts[k].bodies.begin(), parts[k].bodies.end());
-  }
-  std::sort(bodies.begin(), bodies.end(),
-            [](const RecordBody& a, const RecordBody& b) { return a.id < b.id; });
+  // This process's block of the record: its rows of the global order by id.
+  std::vector<RecordBody>& bodies = part.bodies;
+  const collective::Block block =
+      collective::sort_across(*o.comm, bodies, [](const RecordBody& b) { return b.id; });
   const std::size_t n = bodies.size();
   o.ids.resize(n);
   o.r.resize(3 * n);
@@ -564,62 +635,59 @@ void OutputFile::write_record(double t, std::uint64_t step, std::span<RecordPart
       check(H5Gcreate2(o.records.get(), name.c_str(), H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT),
             H5Gclose, o.file, "cannot create record " + name);
   const hid_t real = o.float32 ? H5T_IEEE_F32LE : H5T_IEEE_F64LE;
-  h5::write_array(group.get(), "id", H5T_STD_U64LE, H5T_NATIVE_UINT64, n, 0, o.ids.data(), o.file);
-  h5::write_array(group.get(), "I_r_S", real, H5T_NATIVE_DOUBLE, n, 3, o.r.data(), o.file);
-  h5::write_array(group.get(), "p", real, H5T_NATIVE_DOUBLE, n, 4, o.p.data(), o.file);
-  h5::write_array(group.get(), "I_v_S", real, H5T_NATIVE_DOUBLE, n, 3, o.v.data(), o.file);
-  h5::write_array(group.get(), "K_omega", real, H5T_NATIVE_DOUBLE, n, 3, o.w.data(), o.file);
-  h5::write_array(group.get(), "radius", real, H5T_NATIVE_DOUBLE, n, 0, o.radius.data(), o.file);
+  const hid_t g = group.get(), x = o.transfer.get();
+  const std::uint64_t N = block.total, at = block.offset;
+  h5::write_rows(g, "id", H5T_STD_U64LE, H5T_NATIVE_UINT64, N, 0, at, n, o.ids.data(), x, o.file);
+  h5::write_rows(g, "I_r_S", real, H5T_NATIVE_DOUBLE, N, 3, at, n, o.r.data(), x, o.file);
+  h5::write_rows(g, "p", real, H5T_NATIVE_DOUBLE, N, 4, at, n, o.p.data(), x, o.file);
+  h5::write_rows(g, "I_v_S", real, H5T_NATIVE_DOUBLE, N, 3, at, n, o.v.data(), x, o.file);
+  h5::write_rows(g, "K_omega", real, H5T_NATIVE_DOUBLE, N, 3, at, n, o.w.data(), x, o.file);
+  h5::write_rows(g, "radius", real, H5T_NATIVE_DOUBLE, N, 0, at, n, o.radius.data(), x, o.file);
   // Units and frames: positions and velocities in the inertial frame I, the angular velocity in
   // the body frame K, p the unit quaternion that turns K-coordinates into I-coordinates.
-  h5::describe(group.get(), "id", "1", nullptr, o.file);
-  h5::describe(group.get(), "I_r_S", "m", "I", o.file);
-  h5::describe(group.get(), "p", "1", "K to I", o.file);
-  h5::describe(group.get(), "I_v_S", "m/s", "I", o.file);
-  h5::describe(group.get(), "K_omega", "rad/s", "K", o.file);
-  h5::describe(group.get(), "radius", "m", nullptr, o.file);
-  h5::write_attribute(group.get(), "time", t, o.file);
-  h5::write_attribute(group.get(), "step", step, o.file);
+  h5::describe(g, "id", "1", nullptr, o.file);
+  h5::describe(g, "I_r_S", "m", "I", o.file);
+  h5::describe(g, "p", "1", "K to I", o.file);
+  h5::describe(g, "I_v_S", "m/s", "I", o.file);
+  h5::describe(g, "K_omega", "rad/s", "K", o.file);
+  h5::describe(g, "radius", "m", nullptr, o.file);
+  h5::write_attribute(g, "time", t, o.file);
+  h5::write_attribute(g, "step", step, o.file);
   std::uint64_t contacts = 0;
-  if (o.contacts) {
-    std::vector<RecordContact>& all = parts.front().contacts;
-    for (std::size_t k = 1; k < parts.size(); ++k) {
-      all.insert(all.end(), parts[k].contacts.begin(), parts[k].contacts.end());
-    }
-    std::sort(all.begin(), all.end(),
-              [](const RecordContact& a, const RecordContact& b) { return a.key < b.key; });
-    write_contacts(group.get(), all);
-    contacts = all.size();
-  }
+  if (o.contacts) contacts = write_contacts(g, part.contacts);
   group.close();
-  // The tables may hold rows of a record that a killed run did not count: overwrite them.
-  h5::resize(o.record_time.get(), index, o.file, "records/time");
-  h5::resize(o.record_step.get(), index, o.file, "records/step");
-  h5::resize(o.record_bodies.get(), index, o.file, "records/bodies");
-  const std::uint64_t count = n;
-  h5::append(o.record_time.get(), H5T_NATIVE_DOUBLE, &t, 1, o.file, "records/time");
-  h5::append(o.record_step.get(), H5T_NATIVE_UINT64, &step, 1, o.file, "records/step");
-  h5::append(o.record_bodies.get(), H5T_NATIVE_UINT64, &count, 1, o.file, "records/bodies");
-  if (o.contacts) {
-    h5::resize(o.record_contacts.get(), index, o.file, "records/contacts");
-    h5::append(o.record_contacts.get(), H5T_NATIVE_UINT64, &contacts, 1, o.file,
-               "records/contacts");
-  }
+  // The tables may hold rows of a record that a killed run did not count: overwrite them. Rank 0
+  // writes the row of this record.
+  const std::uint64_t count = N;
+  const auto set_row = [&](hid_t table, hid_t type, const void* value, const char* table_name) {
+    h5::resize(table, index + 1, o.file, table_name);
+    h5::write_at(table, type, index, o.root() ? 1 : 0, 0, value, x, o.file, table_name);
+  };
+  set_row(o.record_time.get(), H5T_NATIVE_DOUBLE, &t, "records/time");
+  set_row(o.record_step.get(), H5T_NATIVE_UINT64, &step, "records/step");
+  set_row(o.record_bodies.get(), H5T_NATIVE_UINT64, &count, "records/bodies");
+  if (o.contacts)
+    set_row(o.record_contacts.get(), H5T_NATIVE_UINT64, &contacts, "records/contacts");
   // Everything of the record on disk first, then the count that makes it part of the file.
   check(H5Fflush(o.handle.get(), H5F_SCOPE_LOCAL), o.file, "cannot flush");
   h5::write_attribute(o.records.get(), "count", index + 1, o.file);
   check(H5Fflush(o.handle.get(), H5F_SCOPE_LOCAL), o.file, "cannot flush");
   written_.records = index + 1;
+  if (!o.root()) return;
   o.times.push_back(t);
   o.counts.push_back(count);
   if (o.contacts) o.contact_counts.push_back(contacts);
   append_xdmf();
 }
+// [write record]
 
 // [write contacts]
-void OutputFile::write_contacts(std::int64_t record, std::span<const RecordContact> contacts) {
+std::uint64_t OutputFile::write_contacts(std::int64_t record,
+                                         std::vector<RecordContact>& contacts) {
   static_assert(std::is_same_v<hid_t, std::int64_t>);
   Impl& o = *impl_;
+  const collective::Block block =
+      collective::sort_across(*o.comm, contacts, [](const RecordContact& c) { return c.key; });
   const std::size_t m = contacts.size();
   o.contact_ids.resize(2 * m);
   o.point.resize(3 * m);
@@ -641,22 +709,26 @@ void OutputFile::write_contacts(std::int64_t record, std::span<const RecordConta
     std::copy(c.lambda_T.begin(), c.lambda_T.end(),
               o.lambda_T.begin() + static_cast<std::ptrdiff_t>(3 * j));
     std::copy(c.line.begin(), c.line.end(), o.line.begin() + static_cast<std::ptrdiff_t>(6 * j));
-    o.line_nodes[2 * j] = 2 * j;
-    o.line_nodes[2 * j + 1] = 2 * j + 1;
+    o.line_nodes[2 * j] = 2 * (block.offset + j);
+    o.line_nodes[2 * j + 1] = 2 * (block.offset + j) + 1;
   }
   Handle group = check(H5Gcreate2(record, "contacts", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT),
                        H5Gclose, o.file, "cannot create a record's contacts");
   const hid_t g = group.get();
   const hid_t real = o.float32 ? H5T_IEEE_F32LE : H5T_IEEE_F64LE;
-  h5::write_array(g, "ids", H5T_STD_U64LE, H5T_NATIVE_UINT64, m, 2, o.contact_ids.data(), o.file);
-  h5::write_array(g, "point", real, H5T_NATIVE_DOUBLE, m, 3, o.point.data(), o.file);
-  h5::write_array(g, "normal", real, H5T_NATIVE_DOUBLE, m, 3, o.normal.data(), o.file);
-  h5::write_array(g, "gap", real, H5T_NATIVE_DOUBLE, m, 0, o.gap.data(), o.file);
-  h5::write_array(g, "lambda_N", real, H5T_NATIVE_DOUBLE, m, 0, o.lambda_N.data(), o.file);
-  h5::write_array(g, "lambda_T", real, H5T_NATIVE_DOUBLE, m, 3, o.lambda_T.data(), o.file);
-  h5::write_array(g, "line", real, H5T_NATIVE_DOUBLE, 2 * m, 3, o.line.data(), o.file);
-  h5::write_array(g, "line_nodes", H5T_STD_U64LE, H5T_NATIVE_UINT64, m, 2, o.line_nodes.data(),
-                  o.file);
+  const hid_t x = o.transfer.get();
+  const std::uint64_t M = block.total, at = block.offset;
+  h5::write_rows(g, "ids", H5T_STD_U64LE, H5T_NATIVE_UINT64, M, 2, at, m, o.contact_ids.data(), x,
+                 o.file);
+  h5::write_rows(g, "point", real, H5T_NATIVE_DOUBLE, M, 3, at, m, o.point.data(), x, o.file);
+  h5::write_rows(g, "normal", real, H5T_NATIVE_DOUBLE, M, 3, at, m, o.normal.data(), x, o.file);
+  h5::write_rows(g, "gap", real, H5T_NATIVE_DOUBLE, M, 0, at, m, o.gap.data(), x, o.file);
+  h5::write_rows(g, "lambda_N", real, H5T_NATIVE_DOUBLE, M, 0, at, m, o.lambda_N.data(), x, o.file);
+  h5::write_rows(g, "lambda_T", real, H5T_NATIVE_DOUBLE, M, 3, at, m, o.lambda_T.data(), x, o.file);
+  h5::write_rows(g, "line", real, H5T_NATIVE_DOUBLE, 2 * M, 3, 2 * at, 2 * m, o.line.data(), x,
+                 o.file);
+  h5::write_rows(g, "line_nodes", H5T_STD_U64LE, H5T_NATIVE_UINT64, M, 2, at, m,
+                 o.line_nodes.data(), x, o.file);
   h5::describe(g, "ids", "1", nullptr, o.file);
   h5::describe(g, "point", "m", "I", o.file);
   h5::describe(g, "normal", "1", "I", o.file);
@@ -665,6 +737,7 @@ void OutputFile::write_contacts(std::int64_t record, std::span<const RecordConta
   h5::describe(g, "lambda_T", "N s", "I", o.file);
   h5::describe(g, "line", "m", "I", o.file);
   h5::describe(g, "line_nodes", "1", nullptr, o.file);
+  return M;
 }
 // [write contacts]
 
@@ -676,12 +749,10 @@ void OutputFile::close(std::vector<timestep::BodyRecord>& created) {
   Impl& o = *impl_;
   write_bodies(created);
   write_steps();
-  for (Handle* h : {&o.record_contacts, &o.record_bodies, &o.record_step, &o.record_time,
-                    &o.records, &o.steps, &o.bodies}) {
-    h->close();
-  }
+  o.close_handles();
   if (!o.handle.close()) h5::fail(o.file, "cannot close the output file");
   o.lock.reset();  // closed: other readers and writers may have it
+  if (!o.root()) return;
   o.xdmf.close();
   if (o.xdmf.fail()) throw IoError(xdmf_path(o.path).string() + ": cannot close the XDMF file");
 }
@@ -781,13 +852,11 @@ void OutputFile::write_xdmf() {
       << "   </Geometry>\n"
       << "   <Attribute Name=\"object\" AttributeType=\"Scalar\" Center=\"Cell\">\n"
       << "    <DataItem Dimensions=\"" << o.static_triangles
-      << "\" NumberType=\"UInt\" Precision=\"4\" Format=\"HDF\">" << base
-      << "object</DataItem>\n"
+      << "\" NumberType=\"UInt\" Precision=\"4\" Format=\"HDF\">" << base << "object</DataItem>\n"
       << "   </Attribute>\n"
       << "  </Grid>\n";
   }
-  x
-    << "  <Grid Name=\"bodies\" GridType=\"Collection\" CollectionType=\"Temporal\">\n";
+  x << "  <Grid Name=\"bodies\" GridType=\"Collection\" CollectionType=\"Temporal\">\n";
   for (std::size_t k = 0; k < o.times.size(); ++k) {
     if (o.counts[k] == 0) continue;  // ParaView cannot show an empty grid
     write_xdmf_grid(x, h5_name, o.float32, k, o.times[k], o.counts[k], o.contacts,
@@ -810,8 +879,8 @@ void OutputFile::append_xdmf() {
   if (o.counts[k] == 0) return;  // ParaView cannot show an empty grid
   std::ostringstream x;
   x.precision(17);
-  write_xdmf_grid(x, o.path.filename().string(), o.float32, k, o.times[k], o.counts[k],
-                  o.contacts, o.contacts ? o.contact_counts[k] : 0);
+  write_xdmf_grid(x, o.path.filename().string(), o.float32, k, o.times[k], o.counts[k], o.contacts,
+                  o.contacts ? o.contact_counts[k] : 0);
   x << kXdmfFooter;
   const std::string text = x.str();
   o.xdmf.seekp(o.xdmf_footer);

@@ -240,6 +240,8 @@ void MpiCommunicator::barrier() const {
   check(MPI_Barrier(impl_->comm), "MPI_Barrier");
 }
 
+const void* MpiCommunicator::mpi_comm() const { return &impl_->comm; }
+
 MpiEnvironment::MpiEnvironment(bool force) {
   if (the_environment != nullptr) {
     throw Error("MpiEnvironment: only one may exist in a program");

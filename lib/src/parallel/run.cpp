@@ -80,139 +80,112 @@ void agreed(const Communicator& comm, Work&& work) {
   if (comm.all(mine.empty())) return;
   std::vector<std::vector<std::byte>> all;
   comm.all_gather(mine, all);
+  // An error every process met alike (a file they read together) needs no rank in its message.
+  const bool alike =
+      std::all_of(all.begin(), all.end(), [&](const auto& e) { return e == all[0]; });
   for (std::size_t r = 0; r < all.size(); ++r) {
     if (all[r].empty()) continue;
     const auto kind = static_cast<ErrorKind>(all[r][0]);
     std::string message(all[r].size() - 1, '\0');
     std::memcpy(message.data(), all[r].data() + 1, message.size());
-    if (comm.size() > 1) message = "rank " + std::to_string(r) + ": " + message;
+    if (comm.size() > 1 && !alike) message = "rank " + std::to_string(r) + ": " + message;
     rethrow(kind, message);
   }
 }
 // [agreed]
 
-// Plain values into a byte buffer and back.
-template <class T>
-void put(std::vector<std::byte>& out, const T* values, std::size_t n) {
-  static_assert(std::is_trivially_copyable_v<T>);
+// Trivially copyable rows into one message per process, and the messages back into rows (in rank
+// order, each message's rows in the order they were sent).
+template <class Row>
+void put(std::vector<std::byte>& out, const Row& row) {
+  static_assert(std::is_trivially_copyable_v<Row>);
   const std::size_t at = out.size();
-  out.resize(at + n * sizeof(T));
-  if (n > 0) std::memcpy(out.data() + at, values, n * sizeof(T));
+  out.resize(at + sizeof(Row));
+  std::memcpy(out.data() + at, &row, sizeof(Row));
 }
 
-class Reader {
- public:
-  explicit Reader(const std::vector<std::byte>& bytes) : bytes_(bytes) {}
-  template <class T>
-  void get(T* values, std::size_t n) {
-    static_assert(std::is_trivially_copyable_v<T>);
-    if (at_ + n * sizeof(T) > bytes_.size()) throw Error("a process sent a truncated message");
-    if (n > 0) std::memcpy(values, bytes_.data() + at_, n * sizeof(T));
-    at_ += n * sizeof(T);
+template <class Row>
+std::vector<Row> rows_of(const std::vector<std::vector<std::byte>>& received) {
+  std::vector<Row> rows;
+  for (const std::vector<std::byte>& part : received) {
+    const std::size_t at = rows.size();
+    rows.resize(at + part.size() / sizeof(Row));
+    if (!part.empty()) std::memcpy(rows.data() + at, part.data(), part.size());
   }
-  template <class T>
-  T value() {
-    T v{};
-    get(&v, 1);
-    return v;
-  }
-
- private:
-  const std::vector<std::byte>& bytes_;
-  std::size_t at_ = 0;
-};
-
-void put_records(std::vector<std::byte>& out, const std::vector<timestep::BodyRecord>& records) {
-  const std::uint64_t n = records.size();
-  put(out, &n, 1);
-  const std::size_t at = out.size();
-  out.resize(at + n * timestep::kPackedBodyBytes);
-  for (std::size_t i = 0; i < records.size(); ++i) {
-    timestep::pack(records[i], std::span<std::byte, timestep::kPackedBodyBytes>(
-                                   out.data() + at + i * timestep::kPackedBodyBytes,
-                                   timestep::kPackedBodyBytes));
-  }
+  return rows;
 }
 
-void get_records(Reader& in, std::vector<timestep::BodyRecord>& records) {
-  const auto n = in.value<std::uint64_t>();
+// [send to owners]
+// After a restart read in slabs (io::read_checkpoint): every body goes to the process that owns
+// its centre, every warm start to the one that solves its contact — the owner of side a, or of
+// side b when side a is a static object (solves_contact()). Who owns a body is known where its
+// row was read; a warm start meets that knowledge at a directory process, id mod P: three
+// exchanges among all processes, each carrying O(N/P) rows. The rows keep the file's order.
+void send_to_owners(const Communicator& comm, const SceneDecomposition& decomposition,
+                    scene::SimulationState& state) {
+  const int P = comm.size();
+  if (P == 1) return;
+  std::vector<int> everyone(static_cast<std::size_t>(P));
+  for (int r = 0; r < P; ++r) everyone[static_cast<std::size_t>(r)] = r;
+  const auto to = [&](std::uint64_t id) { return static_cast<std::size_t>(id % std::uint64_t(P)); };
+  struct Owner {
+    std::uint64_t id;
+    std::int64_t rank;
+  };
+  struct Warm {
+    timestep::ContactKey key;
+    double lambda[3];
+    std::int64_t rank;  // the process that solves it, once known
+  };
+  std::vector<std::vector<std::byte>> bodies(everyone.size()), owners(everyone.size()),
+      warm(everyone.size()), received;
   timestep::PackedBody packed;
-  for (std::uint64_t i = 0; i < n; ++i) {
-    in.get(packed.data(), packed.size());
-    records.push_back(timestep::unpack(packed));
+  for (const timestep::BodyRecord& body : state.bodies) {
+    const int owner = decomposition.owner(body.state.q.head<3>());
+    timestep::pack(body, packed);
+    put(bodies[static_cast<std::size_t>(owner)], packed);
+    put(owners[to(body.id)], Owner{body.id, owner});
   }
-}
-
-// The parts of a record (or only the created bodies) from every process, on rank 0.
-std::vector<io::RecordPart> gather_parts(const Communicator& comm, io::RecordPart& part) {
-  std::vector<std::byte> bytes;
-  const std::uint64_t counts[2] = {part.bodies.size(), part.contacts.size()};
-  put(bytes, counts, 2);
-  put(bytes, part.bodies.data(), part.bodies.size());
-  put(bytes, part.contacts.data(), part.contacts.size());
-  put_records(bytes, part.created);
-  part.created.clear();
-  std::vector<std::vector<std::byte>> all;
-  comm.gather(bytes, all, 0);
-  std::vector<io::RecordPart> parts(all.size());
-  for (std::size_t r = 0; r < all.size(); ++r) {
-    Reader in(all[r]);
-    std::uint64_t n[2];
-    in.get(n, 2);
-    parts[r].bodies.resize(n[0]);
-    in.get(parts[r].bodies.data(), n[0]);
-    parts[r].contacts.resize(n[1]);
-    in.get(parts[r].contacts.data(), n[1]);
-    get_records(in, parts[r].created);
+  const auto solver_side = [](const timestep::ContactKey& key) {
+    return (key.a & timestep::kStaticTag) != 0 ? key.b : key.a;
+  };
+  for (std::size_t k = 0; k < state.warm_keys.size(); ++k) {
+    const Vector3& l = state.warm_lambda[k];
+    const timestep::ContactKey& key = state.warm_keys[k];
+    put(warm[to(solver_side(key))], Warm{key, {l[0], l[1], l[2]}, -1});
   }
-  return parts;
-}
-
-// The checkpoint of the whole run on rank 0: this process's state with every process's bodies
-// (ascending id) and warm starts (ascending key, each once).
-std::optional<scene::SimulationState> gather_state(const Communicator& comm,
-                                                   const scene::Simulation& sim) {
-  scene::SimulationState state = sim.save();
-  std::vector<std::byte> bytes;
-  put_records(bytes, state.bodies);
-  const std::uint64_t m = state.warm_keys.size();
-  put(bytes, &m, 1);
-  put(bytes, state.warm_keys.data(), m);
-  for (const Vector3& lambda : state.warm_lambda) put(bytes, lambda.data(), 3);
-  std::vector<std::vector<std::byte>> all;
-  comm.gather(bytes, all, 0);
-  if (comm.rank() != 0) return std::nullopt;
+  comm.exchange(everyone, bodies, received);
   state.bodies.clear();
-  std::vector<std::pair<timestep::ContactKey, Vector3>> warm;
-  for (const std::vector<std::byte>& part : all) {
-    Reader in(part);
-    get_records(in, state.bodies);
-    const auto n = in.value<std::uint64_t>();
-    std::vector<timestep::ContactKey> keys(n);
-    in.get(keys.data(), n);
-    for (std::size_t k = 0; k < n; ++k) {
-      Vector3 lambda;
-      in.get(lambda.data(), 3);
-      warm.emplace_back(keys[k], lambda);
-    }
+  for (const timestep::PackedBody& row : rows_of<timestep::PackedBody>(received)) {
+    state.bodies.push_back(timestep::unpack(row));
   }
-  std::sort(
-      state.bodies.begin(), state.bodies.end(),
-      [](const timestep::BodyRecord& a, const timestep::BodyRecord& b) { return a.id < b.id; });
-  std::sort(warm.begin(), warm.end(),
-            [](const auto& a, const auto& b) { return a.first < b.first; });
-  // After a restart every process holds every warm start until its first step: keep one each.
-  warm.erase(std::unique(warm.begin(), warm.end(),
-                         [](const auto& a, const auto& b) { return a.first == b.first; }),
-             warm.end());
+  // The directory: the owner of each body whose id it holds, and the warm starts of those ids.
+  comm.exchange(everyone, owners, received);
+  const std::vector<Owner> directory = [&] {
+    std::vector<Owner> d = rows_of<Owner>(received);
+    std::sort(d.begin(), d.end(), [](const Owner& a, const Owner& b) { return a.id < b.id; });
+    return d;
+  }();
+  comm.exchange(everyone, warm, received);
+  std::vector<Warm> rows = rows_of<Warm>(received);
+  for (std::vector<std::byte>& out : warm) out.clear();
+  for (Warm& w : rows) {
+    const std::uint64_t id = solver_side(w.key);
+    const auto it = std::lower_bound(directory.begin(), directory.end(), id,
+                                     [](const Owner& o, std::uint64_t x) { return o.id < x; });
+    // A warm start of a body the checkpoint does not hold is of no use to anyone.
+    if (it == directory.end() || it->id != id) continue;
+    put(warm[static_cast<std::size_t>(it->rank)], w);
+  }
+  comm.exchange(everyone, warm, received);
   state.warm_keys.clear();
   state.warm_lambda.clear();
-  for (const auto& [key, lambda] : warm) {
-    state.warm_keys.push_back(key);
-    state.warm_lambda.push_back(lambda);
+  for (const Warm& w : rows_of<Warm>(received)) {
+    state.warm_keys.push_back(w.key);
+    state.warm_lambda.emplace_back(w.lambda[0], w.lambda[1], w.lambda[2]);
   }
-  return state;
 }
+// [send to owners]
 
 // The skin of the parallel step: the scene's, or half its tolerance radius.
 double skin_of(const timestep::StepSettings& s) {
@@ -284,36 +257,21 @@ io::RunResult run(const scene::Scene& scene, const io::RunOptions& options,
   io::RunResult result;
   std::unique_ptr<scene::Simulation> simulation;
   std::unique_ptr<io::OutputFile> output;
-  io::RecordPart part;
-  std::vector<timestep::BodyRecord> created;  // rank 0: gathered, not yet written
-  const auto gather_created = [&](scene::Simulation& sim) {
-    part.bodies.clear();
-    part.contacts.clear();
-    part.created.swap(sim.created());
-    sim.created().clear();
-    std::vector<io::RecordPart> parts = gather_parts(comm, part);
-    for (io::RecordPart& p : parts) {
-      created.insert(created.end(), p.created.begin(), p.created.end());
-    }
-  };
+  // Every process writes its own bodies and contacts into the one file (parallel HDF5).
   const auto write_record = [&](scene::Simulation& sim) {
+    io::RecordPart part;
     io::collect_record(sim, scene.output.contacts, part);
-    std::vector<io::RecordPart> parts = gather_parts(comm, part);
-    agreed(comm, [&] {
-      if (!root) return;
-      parts.front().created.insert(parts.front().created.end(), created.begin(), created.end());
-      created.clear();
-      output->write_record(sim.stepper().time(), sim.stepper().steps(), parts);
-    });
+    agreed(comm, [&] { output->write_record(sim.stepper().time(), sim.stepper().steps(), part); });
   };
   if (options.restart) {
     io::Checkpoint checkpoint;
-    agreed(comm, [&] { checkpoint = io::read_checkpoint(*options.restart); });
+    agreed(comm, [&] { checkpoint = io::read_checkpoint(comm, *options.restart); });
     if (const std::string difference =
             io::scene_difference(checkpoint.scene_text, scene.text, scene.file);
         root && !difference.empty() && options.on_warning) {
       options.on_warning(difference);
     }
+    send_to_owners(comm, *decomposition, checkpoint.state);
     agreed(comm, [&] {
       simulation = io::restored_simulation(scene, checkpoint, *options.restart, &*decomposition);
     });
@@ -329,21 +287,19 @@ io::RunResult run(const scene::Scene& scene, const io::RunOptions& options,
         simulation->created().push_back(simulation->system().record(i));
       }
     }
+    // Rank 0 checks that an output it reopens is this run's with the bodies it holds.
     agreed(comm, [&] {
-      if (!root) return;
       output = exists[0] != std::byte{0}
                    ? std::make_unique<io::OutputFile>(
                          options.output, scene, checkpoint.output,
-                         io::RunIdentity{checkpoint.scene_text, checkpoint.state.bodies})
-                   : std::make_unique<io::OutputFile>(options.output, scene);
+                         io::RunIdentity{checkpoint.scene_text, checkpoint.state.bodies}, comm)
+                   : std::make_unique<io::OutputFile>(options.output, scene, comm);
     });
   } else {
     agreed(comm, [&] {
       simulation = std::make_unique<scene::Simulation>(scene, nullptr, *decomposition);
     });
-    agreed(comm, [&] {
-      if (root) output = std::make_unique<io::OutputFile>(options.output, scene);
-    });
+    agreed(comm, [&] { output = std::make_unique<io::OutputFile>(options.output, scene, comm); });
     write_record(*simulation);
   }
   scene::Simulation& sim = *simulation;
@@ -354,13 +310,10 @@ io::RunResult run(const scene::Scene& scene, const io::RunOptions& options,
     if (saved_at == sim.stepper().steps()) return;
     saved_at = sim.stepper().steps();
     const auto t0 = std::chrono::steady_clock::now();
-    gather_created(sim);
-    std::optional<scene::SimulationState> state = gather_state(comm, sim);
     agreed(comm, [&] {
-      if (!root) return;
-      output->flush(created);
-      io::write_checkpoint(options.checkpoint,
-                           io::Checkpoint{std::move(*state), output->position(), scene.text});
+      output->flush(sim);
+      io::write_checkpoint(comm, options.checkpoint,
+                           io::Checkpoint{sim.save(), output->position(), scene.text});
     });
     ++result.checkpoints;
     result.output_seconds += seconds_since(t0);
@@ -385,15 +338,15 @@ io::RunResult run(const scene::Scene& scene, const io::RunOptions& options,
     try {
       report = sim.step();
     } catch (const std::exception& e) {
-      // The other processes wait in the step's exchanges: only an abort ends them. Rank 0's
-      // output holds every record before this step (each is counted once it is complete).
+      // The other processes wait in the step's exchanges: only an abort ends them. The output
+      // holds every record before this step (each is counted once it is complete).
       abort_run(std::string("the run failed: ") + e.what(), 1);
     }
     result.step_seconds += seconds_since(t0);
     ++result.steps;
     std::uint64_t bodies[1] = {sim.system().owned_count()};
     comm.sum(bodies);
-    if (root) output->add_step(report, bodies[0]);
+    output->add_step(report, bodies[0]);
     recorded = false;
     const std::uint64_t step = sim.stepper().steps();
     if (every > 0 && step % every == 0) {
@@ -411,18 +364,9 @@ io::RunResult run(const scene::Scene& scene, const io::RunOptions& options,
     write_record(sim);
     result.output_seconds += seconds_since(t1);
   }
-  gather_created(sim);
-  agreed(comm, [&] {
-    if (root) output->close(created);
-  });
+  agreed(comm, [&] { output->close(sim); });
   if (root && result.stop_file) io::remove_stop_file(options);
-  std::vector<std::byte> records(sizeof(std::uint64_t));
-  if (root) {
-    const std::uint64_t n = output->position().records;
-    std::memcpy(records.data(), &n, sizeof n);
-  }
-  comm.broadcast(records, 0);
-  std::memcpy(&result.records, records.data(), sizeof result.records);
+  result.records = output->position().records;
   result.seconds = seconds_since(start);
   return result;
 }

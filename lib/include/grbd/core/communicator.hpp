@@ -62,6 +62,9 @@ class Communicator {
                         std::vector<std::vector<std::byte>>& received) const = 0;
   /// Waits until every process has called it.
   virtual void barrier() const = 0;
+  /// The address of the MPI communicator (an `MPI_Comm`) behind this one, for a library that
+  /// works collectively over it (parallel HDF5); nullptr for a communicator without MPI.
+  virtual const void* mpi_comm() const { return nullptr; }
 
   /// What this process has sent through the communicator so far: the point-to-point messages of
   /// exchange() (a size and a body for each neighbour that is not this process) with their bytes,

@@ -18,14 +18,23 @@ struct Checkpoint {
   std::string scene_text;        ///< the scene the run was started from
 };
 
-/// The format version written to checkpoints. Version 2 adds the attribute `checksum` over every
-/// value; version 1 (without it) is still read.
-inline constexpr std::uint64_t kCheckpointFormatVersion = 2;
+/// The format version written to checkpoints. Version 3's `checksum` is formed from the rows of
+/// bodies and warm starts independently, so that processes that each read or write a slab of
+/// rows form it together; version 2 (a checksum of every value in sequence) and version 1
+/// (without one) are still read.
+inline constexpr std::uint64_t kCheckpointFormatVersion = 3;
 
 /// Writes `checkpoint` to `path` atomically: into a temporary file beside it, flushed to the disk
 /// (fsync), then renamed over `path`, so that a crash at any moment leaves either the previous
 /// checkpoint or the new one. Throws IoError naming the file.
 void write_checkpoint(const std::filesystem::path& path, const Checkpoint& checkpoint);
+/// The same by the processes of `comm` together (collective): each gives its own bodies and warm
+/// starts in `checkpoint.state` (the rest is the same on every process), and the file holds
+/// them in the global order, bodies by id and warm starts by key (each once), written with
+/// parallel HDF5; rank 0 flushes and renames. With one process, the state's own order (a serial
+/// run's order of bodies is part of its state). An error is thrown on every process.
+void write_checkpoint(const Communicator& comm, const std::filesystem::path& path,
+                      const Checkpoint& checkpoint);
 
 /// Reads a checkpoint; throws IoError naming the file and the dataset or attribute that is
 /// missing, of the wrong shape, or holds values that are not finite or out of range (a state,
@@ -34,5 +43,12 @@ void write_checkpoint(const std::filesystem::path& path, const Checkpoint& check
 /// the scene (Δt against t and steps, each body's mass and inertia) is checked by
 /// scene::Simulation's restart constructor.
 Checkpoint read_checkpoint(const std::filesystem::path& path);
+/// The same by the processes of `comm` together (collective): each reads every attribute and the
+/// generators, and a slab of about 1/P of the rows of bodies and warm starts (rank r the r-th, in
+/// the file's order) — its part of the checksum, summed over the processes, is checked against
+/// the one written (a version 1 or 2 checkpoint is read whole by each, and then cut to its
+/// slab). The slabs are not yet where the bodies belong: the parallel run sends each body to its
+/// owner. An error is thrown on every process.
+Checkpoint read_checkpoint(const Communicator& comm, const std::filesystem::path& path);
 
 }  // namespace grbd::io

@@ -32,6 +32,7 @@
 #include <string_view>
 #include <vector>
 
+#include "grbd/core/communicator.hpp"
 #include "grbd/core/error.hpp"
 #include "grbd/scene/simulation.hpp"
 #include "grbd/timestep/stepper.hpp"
@@ -121,35 +122,44 @@ void collect_record(scene::Simulation& simulation, bool contacts, RecordPart& pa
 /// The output file of a run. Steps are buffered and written with each record (or flush()).
 /// While it is open, the file is locked (flock, as HDF5 does): a second OutputFile of the same
 /// file, in this process or another, is refused before anything is changed.
+///
+/// The processes of a communicator write one file together (chapter 8): rank 0 creates or
+/// reopens it alone (every check, the XDMF file, the lock), then every process opens it with
+/// parallel HDF5 (MPI-IO), and each record is written collectively, each process writing its
+/// block of rows of the global order by id (and by key for contacts). Every call is then
+/// collective; an error is thrown on every process. The file is the one a single process writes.
 class OutputFile {
  public:
   /// Creates `path` (replacing a file of that name, once it holds the lock) and the XDMF file
   /// beside it (`.xmf`). Throws IoError, having changed nothing, when another process holds
   /// the file.
-  OutputFile(const std::filesystem::path& path, const scene::Scene& scene);
+  OutputFile(const std::filesystem::path& path, const scene::Scene& scene,
+             const Communicator& comm = self_communicator());
   /// Reopens the output of an earlier run for a restart: keeps what `at` counts and drops the
   /// rest (records, steps and bodies written after the checkpoint). Throws IoError, having
   /// changed nothing, when the file is not a grbd output, holds less than `at`, or belongs to
   /// another run (its scene text is not `run.scene_text`, or a body of `run.bodies` is not in its
   /// table with the same constants).
-  OutputFile(const std::filesystem::path& path, const scene::Scene& scene,
-             const OutputPosition& at, const RunIdentity& run);
+  OutputFile(const std::filesystem::path& path, const scene::Scene& scene, const OutputPosition& at,
+             const RunIdentity& run, const Communicator& comm = self_communicator());
   ~OutputFile();
   OutputFile(const OutputFile&) = delete;
   OutputFile& operator=(const OutputFile&) = delete;
 
-  /// Buffers the row of one step.
+  /// Buffers the row of one step (every process adds the same steps; rank 0's rows, with its
+  /// timings, are written).
   void add_step(const timestep::StepReport& report, std::size_t bodies);
   /// Writes the bodies created since the last call, the buffered steps and a record of every
   /// body's q and u (rows sorted by id); flushes, then counts the record; rewrites the XDMF.
   void write_record(scene::Simulation& simulation);
-  /// The same from the parts of every process of a parallel run (or the one of a serial run):
-  /// the record of time t after `step` steps holds their bodies sorted by id, their contacts
-  /// sorted by key; /bodies gets their created bodies sorted by id. The parts are used up.
-  void write_record(double t, std::uint64_t step, std::span<RecordPart> parts);
+  /// The same from this process's part (collective: every process gives its own): the record of
+  /// time t after `step` steps holds the bodies of every part sorted by id, their contacts sorted
+  /// by key; /bodies gets their created bodies sorted by id. The part is used up.
+  void write_record(double t, std::uint64_t step, RecordPart& part);
   /// Writes the bodies created and the buffered steps, and flushes (before a checkpoint).
   void flush(scene::Simulation& simulation);
-  /// The same with the bodies created (of every process; sorted by id here, and used up).
+  /// The same with the bodies this process created (collective; sorted by id over every process,
+  /// and used up).
   void flush(std::vector<timestep::BodyRecord>& created);
   /// Whether this file keeps the contacts of each record ([output] contacts).
   bool contacts() const;
@@ -165,9 +175,14 @@ class OutputFile {
 
  private:
   struct Impl;
+  // What the constructors do on rank 0 alone, and the opening by every process that follows.
+  void create(const scene::Scene& scene);
+  void reopen(const scene::Scene& scene, const OutputPosition& at, const RunIdentity& run);
+  void share();
   void write_bodies(std::vector<timestep::BodyRecord>& created);
-  // The group `contacts` of a record (with [output] contacts), sorted by key.
-  void write_contacts(std::int64_t record, std::span<const RecordContact> contacts);
+  // The group `contacts` of a record (with [output] contacts), sorted by key; returns how many
+  // contacts every process wrote.
+  std::uint64_t write_contacts(std::int64_t record, std::vector<RecordContact>& contacts);
   void write_steps();
   // The XDMF is written whole (atomically) when the file is created or reopened, and each record
   // is appended in place over its closing tags: O(1) per record, not O(records).
@@ -197,24 +212,24 @@ class Hdf5Cleanup {
 
 /// What `grbd info` says about an output file.
 struct OutputSummary {
-  std::string scene_file;            ///< attribute scene_file
-  std::string grbd_version;          ///< attribute grbd_version
-  std::string date;                  ///< attribute date
-  std::string host;                  ///< attribute host
-  std::string precision;             ///< "double" or "float"
-  std::uint64_t bodies = 0;          ///< rows of /bodies
-  std::uint64_t steps = 0;           ///< rows of /steps
-  std::uint64_t records = 0;         ///< complete records
-  double t_first = 0.0;              ///< time of the first record [s]
-  double t_last = 0.0;               ///< time of the last record [s]
-  std::uint64_t bodies_last = 0;     ///< bodies in the last record
-  std::uint64_t max_contacts = 0;    ///< over the steps
-  double mean_iterations = 0.0;      ///< over the steps
-  std::uint64_t max_iterations = 0;  ///< over the steps
-  std::uint64_t non_converged = 0;   ///< steps that did not converge
+  std::string scene_file;                      ///< attribute scene_file
+  std::string grbd_version;                    ///< attribute grbd_version
+  std::string date;                            ///< attribute date
+  std::string host;                            ///< attribute host
+  std::string precision;                       ///< "double" or "float"
+  std::uint64_t bodies = 0;                    ///< rows of /bodies
+  std::uint64_t steps = 0;                     ///< rows of /steps
+  std::uint64_t records = 0;                   ///< complete records
+  double t_first = 0.0;                        ///< time of the first record [s]
+  double t_last = 0.0;                         ///< time of the last record [s]
+  std::uint64_t bodies_last = 0;               ///< bodies in the last record
+  std::uint64_t max_contacts = 0;              ///< over the steps
+  double mean_iterations = 0.0;                ///< over the steps
+  std::uint64_t max_iterations = 0;            ///< over the steps
+  std::uint64_t non_converged = 0;             ///< steps that did not converge
   std::uint64_t non_converged_iterations = 0;  ///< the iterations they stopped at: the cap
-  double max_penetration = 0.0;      ///< over the steps [m]
-  double seconds = 0.0;              ///< wall time of the steps [s]
+  double max_penetration = 0.0;                ///< over the steps [m]
+  double seconds = 0.0;                        ///< wall time of the steps [s]
 };
 
 /// Reads the summary of an output file (IoError naming the file and dataset when it is not one).

@@ -44,6 +44,7 @@ class MpiCommunicator final : public Communicator {
   void exchange(std::span<const int> neighbours, std::span<const std::vector<std::byte>> send,
                 std::vector<std::vector<std::byte>>& received) const override;
   void barrier() const override;
+  const void* mpi_comm() const override;
 
  private:
   struct Impl;

@@ -36,8 +36,10 @@ class SceneDecomposition final : public scene::Distribution {
   const Communicator& communicator() const override { return comm_; }
   /// Whether the grid gives a body centred at `centre` to this process (the engine's grid once
   /// there is one: it may have been rebalanced since).
-  bool owns(const Vector3& centre) const override {
-    return (engine_ != nullptr ? engine_->grid() : grid_).owner_of(centre) == comm_.rank();
+  bool owns(const Vector3& centre) const override { return owner(centre) == comm_.rank(); }
+  /// The process that owns a body with this centre (the engine's grid once there is an engine).
+  int owner(const Vector3& centre) const {
+    return (engine_ != nullptr ? engine_->grid() : grid_).owner_of(centre);
   }
   /// A ParallelStepper over the grid (the scene's settings, with a skin of half the tolerance
   /// radius when they give none).
