@@ -202,22 +202,6 @@ void resize(hid_t dataset, std::uint64_t n, const std::string& file, const std::
   check(H5Dset_extent(dataset, &size), file, "cannot resize " + name);
 }
 
-void append(hid_t dataset, hid_t memory_type, const void* data, std::uint64_t n,
-            const std::string& file, const std::string& name) {
-  if (n == 0) return;
-  const std::uint64_t old = rows(dataset, file, name);
-  resize(dataset, old + n, file, name);
-  Handle space = check(H5Dget_space(dataset), H5Sclose, file, "cannot read the shape of " + name);
-  const hsize_t start = old;
-  const hsize_t count = n;
-  check(H5Sselect_hyperslab(space.get(), H5S_SELECT_SET, &start, nullptr, &count, nullptr), file,
-        "cannot select rows of " + name);
-  Handle memory =
-      check(H5Screate_simple(1, &count, nullptr), H5Sclose, file, "cannot create a dataspace");
-  check(H5Dwrite(dataset, memory_type, memory.get(), space.get(), H5P_DEFAULT, data), file,
-        "cannot write " + name);
-}
-
 Handle shared_access(const Communicator& comm, const std::string& file) {
   Handle access =
       check(H5Pcreate(H5P_FILE_ACCESS), H5Pclose, file, "cannot create a property list");
@@ -274,16 +258,7 @@ void write_rows(hid_t location, const char* name, hid_t file_type, hid_t memory_
 void write_array(hid_t location, const char* name, hid_t file_type, hid_t memory_type,
                  std::uint64_t rows, std::uint64_t cols, const void* data,
                  const std::string& file) {
-  const hsize_t dims[2] = {rows, cols};
-  Handle space = check(H5Screate_simple(cols == 0 ? 1 : 2, dims, nullptr), H5Sclose, file,
-                       "cannot create a dataspace");
-  Handle dataset = check(
-      H5Dcreate2(location, name, file_type, space.get(), H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT),
-      H5Dclose, file, std::string("cannot create dataset ") + name);
-  if (rows > 0) {
-    check(H5Dwrite(dataset.get(), memory_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, data), file,
-          std::string("cannot write dataset ") + name);
-  }
+  write_rows(location, name, file_type, memory_type, rows, cols, 0, rows, data, H5P_DEFAULT, file);
 }
 
 std::uint64_t rows_of(hid_t location, const char* name, hid_t memory_type, std::uint64_t cols,

@@ -89,9 +89,6 @@ Handle create_table(hid_t location, const char* name, hid_t type, hsize_t chunk,
                     const std::string& file);
 /// Rows of a 1-D dataset.
 std::uint64_t rows(hid_t dataset, const std::string& file, const std::string& name);
-/// Appends n rows of `memory_type`.
-void append(hid_t dataset, hid_t memory_type, const void* data, std::uint64_t n,
-            const std::string& file, const std::string& name);
 /// Sets the rows of a 1-D extendable dataset.
 void resize(hid_t dataset, std::uint64_t n, const std::string& file, const std::string& name);
 

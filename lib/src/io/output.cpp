@@ -252,21 +252,15 @@ std::filesystem::path OutputFile::xdmf_path(const std::filesystem::path& path) {
 }
 
 OutputFile::OutputFile(const std::filesystem::path& path, const scene::Scene& scene,
-                       const Communicator& comm) {
-  std::lock_guard lock(hdf5::mutex());
-  hdf5::QuietErrors quiet;
-  impl_.reset(new Impl);  // its compound types are HDF5 objects: made under the lock
-  impl_->comm = &comm;
-  impl_->path = path;
-  impl_->file = path.string();
-  collective::agree(comm, [&] {
-    if (comm.rank() == 0) create(scene);
-  });
-  share();
-}
+                       const Communicator& comm)
+    : OutputFile(path, comm, [&] { create(scene); }) {}
 
 OutputFile::OutputFile(const std::filesystem::path& path, const scene::Scene& scene,
-                       const OutputPosition& at, const RunIdentity& run, const Communicator& comm) {
+                       const OutputPosition& at, const RunIdentity& run, const Communicator& comm)
+    : OutputFile(path, comm, [&] { reopen(scene, at, run); }) {}
+
+OutputFile::OutputFile(const std::filesystem::path& path, const Communicator& comm,
+                       const std::function<void()>& on_rank_0) {
   std::lock_guard lock(hdf5::mutex());
   hdf5::QuietErrors quiet;
   impl_.reset(new Impl);  // its compound types are HDF5 objects: made under the lock
@@ -274,7 +268,7 @@ OutputFile::OutputFile(const std::filesystem::path& path, const scene::Scene& sc
   impl_->path = path;
   impl_->file = path.string();
   collective::agree(comm, [&] {
-    if (comm.rank() == 0) reopen(scene, at, run);
+    if (comm.rank() == 0) on_rank_0();
   });
   share();
 }

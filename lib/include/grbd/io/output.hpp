@@ -26,6 +26,7 @@
 #include <array>
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <memory>
 #include <span>
 #include <string>
@@ -175,6 +176,9 @@ class OutputFile {
 
  private:
   struct Impl;
+  // Runs `on_rank_0` (create or reopen) on rank 0, agreed, then share().
+  OutputFile(const std::filesystem::path& path, const Communicator& comm,
+             const std::function<void()>& on_rank_0);
   // What the constructors do on rank 0 alone, and the opening by every process that follows.
   void create(const scene::Scene& scene);
   void reopen(const scene::Scene& scene, const OutputPosition& at, const RunIdentity& run);
