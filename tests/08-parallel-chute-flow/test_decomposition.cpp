@@ -11,6 +11,8 @@
 #include <vector>
 
 #include "grbd/core/error.hpp"
+#include "grbd/parallel/balance.hpp"
+#include "grbd/parallel/bisection.hpp"
 #include "grbd/parallel/decomposition.hpp"
 #include "grbd/timestep/contacts.hpp"
 
@@ -230,6 +232,105 @@ TEST(CartesianGrid, TakesBoundariesThatIncreaseAcrossTheDomain) {
         std::vector<double>{0.0}}) {
     EXPECT_THROW(CartesianGrid(domain, {bad, {0.0, 1.0}, {0.0, 1.0}}), InvalidArgument);
   }
+}
+
+}  // namespace
+}  // namespace grbd::parallel
+
+namespace grbd::parallel {
+namespace {
+
+// Recursive coordinate bisection: the leaves tile the domain, and owner_of agrees with them.
+TEST(BisectionTree, LeavesTileTheDomainAndOwnEveryPositionOnce) {
+  const Box domain(Vector3(-1, 0, 0), Vector3(2, 1, 0.5));
+  for (const int p : {1, 2, 3, 5, 7, 12}) {
+    const grbd::parallel::BisectionTree tree(domain, p);
+    ASSERT_EQ(tree.size(), p);
+    double volume = 0.0;
+    for (int r = 0; r < p; ++r) volume += tree.subdomain(r).volume();
+    EXPECT_NEAR(volume, domain.volume(), 1e-12);
+    std::mt19937_64 random(p);
+    std::uniform_real_distribution<double> u(0.0, 1.0);
+    for (int k = 0; k < 2000; ++k) {
+      const Vector3 x(-1 + 3 * u(random), u(random), 0.5 * u(random));
+      const int owner = tree.owner_of(x);
+      int holders = 0;
+      for (int r = 0; r < p; ++r) {
+        const Box& b = tree.subdomain(r);
+        holders += (x.array() >= b.min().array()).all() && (x.array() < b.max().array()).all();
+      }
+      EXPECT_EQ(holders, 1);
+      const Box& b = tree.subdomain(owner);
+      EXPECT_TRUE((x.array() >= b.min().array()).all() && (x.array() < b.max().array()).all());
+      // A position outside the domain belongs to the leaf whose owned region holds it.
+      const Vector3 out(x.x() + 5.0, x.y(), x.z() - 3.0);
+      const Box region = tree.owned_region(tree.owner_of(out));
+      EXPECT_TRUE((out.array() >= region.min().array()).all() &&
+                  (out.array() <= region.max().array()).all());
+    }
+  }
+  EXPECT_THROW(grbd::parallel::BisectionTree(domain, 0), grbd::InvalidArgument);
+  EXPECT_THROW(grbd::parallel::BisectionTree(Box(Vector3(0, 0, 0), Vector3(1, 0, 1)), 2),
+               grbd::InvalidArgument);
+}
+
+// Two positions within the reach of each other have owners that are neighbours (or the same),
+// also through the periodic boundary; neighbourhood is symmetric.
+TEST(BisectionTree, OwnersOfPositionsWithinReachAreNeighbours) {
+  const Box domain(Vector3(0, 0, 0), Vector3(1, 1, 1));
+  const grbd::parallel::BisectionTree tree(domain, 9, {true, false, false});
+  const double reach = 0.05;
+  std::mt19937_64 random(7);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  for (int k = 0; k < 5000; ++k) {
+    const Vector3 x(u(random), u(random), u(random));
+    Vector3 step(u(random) - 0.5, u(random) - 0.5, u(random) - 0.5);
+    const Vector3 y = x + reach * u(random) * step.normalized();
+    const int a = tree.owner_of(x), b = tree.owner_of(y);  // y may cross x = 0 or 1: wrapped
+    if (a == b) continue;
+    const std::vector<int> n = tree.neighbours(a, reach);
+    EXPECT_TRUE(std::binary_search(n.begin(), n.end(), b)) << a << " " << b;
+  }
+  for (int r = 0; r < tree.size(); ++r) {
+    for (const int s : tree.neighbours(r, reach)) {
+      const std::vector<int> back = tree.neighbours(s, reach);
+      EXPECT_TRUE(std::binary_search(back.begin(), back.end(), r));
+    }
+  }
+}
+
+// Bodies crowded into one corner: the bisection balances the weight to within a few bodies on
+// every process, where the tensor grid of per-axis quantiles cannot (its cuts along x and y are
+// shared by all rows and columns).
+TEST(BisectionTree, BalancesALoadThatIsUnevenInTwoDirections) {
+  const Box domain(Vector3(0, 0, 0), Vector3(1, 1, 0.1));
+  std::vector<Vector3> centres;
+  std::vector<double> weights;
+  std::mt19937_64 random(3);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  for (int i = 0; i < 20000; ++i) {
+    // Half the bodies uniform, half crowded into the corner x, y < 0.2.
+    const double s = i % 2 == 0 ? 1.0 : 0.2;
+    centres.emplace_back(s * u(random), s * u(random), 0.1 * u(random));
+    weights.push_back(1.0);
+  }
+  const int p = 4;
+  const auto tree = grbd::parallel::BisectionTree::balanced(
+      grbd::self_communicator(), domain, p, {false, false, false}, centres, weights);
+  const CartesianGrid grid = grbd::parallel::balanced_grid(
+      grbd::self_communicator(), domain, {2, 2, 1}, {false, false, false}, centres, weights);
+  std::vector<double> by_tree(p), by_grid(p);
+  for (std::size_t i = 0; i < centres.size(); ++i) {
+    by_tree[static_cast<std::size_t>(tree.owner_of(centres[i]))] += weights[i];
+    by_grid[static_cast<std::size_t>(grid.owner_of(centres[i]))] += weights[i];
+  }
+  const double mean = 20000.0 / p;
+  for (const double w : by_tree) EXPECT_NEAR(w, mean, 3.0);
+  EXPECT_GT(*std::max_element(by_grid.begin(), by_grid.end()) / mean, 1.3);
+  EXPECT_THROW(grbd::parallel::BisectionTree::balanced(grbd::self_communicator(), domain, p,
+                                                       {false, false, false}, centres,
+                                                       std::vector<double>(3, 1.0)),
+               grbd::InvalidArgument);
 }
 
 }  // namespace

@@ -14,6 +14,7 @@
 #include "grbd/core/error.hpp"
 #include "grbd/core/hash.hpp"
 #include "grbd/parallel/balance.hpp"
+#include "grbd/parallel/bisection.hpp"
 #include "grbd/parallel/exchange.hpp"
 #include "grbd/parallel/mpi.hpp"
 #include "grbd/parallel/stepper.hpp"
@@ -497,6 +498,38 @@ TEST(BalancedGrid, IsTheSameForEveryDistributionOfTheBodies) {
     slab[static_cast<std::size_t>(one.owner_of(all[i]))] += weights[i];
   for (const double w : slab) EXPECT_NEAR(w, 12500.0 / 4.0, 4.0);
   EXPECT_LT(one.boundaries(0)[1], 0.5);  // the crowd near x = 0 gets narrow slabs
+}
+
+// The bisection tree from bodies spread over the processes is the tree of all of them on one:
+// every cut (and so every owner) the same.
+TEST(BisectionTree, IsTheSameForEveryDistributionOfTheBodies) {
+  const Box domain(Vector3(0, 0, 0), Vector3(2, 1, 1));
+  std::vector<Vector3> all, part;
+  std::vector<double> weights, part_weights;
+  for (std::uint64_t i = 0; i < 5000; ++i) {
+    // crowded towards the corner x = y = 0: x = 2 u³, y = v²
+    const double u = 0.5 * (noise(i, 12, 0) + 1.0), v = 0.5 * (noise(i, 12, 1) + 1.0);
+    all.emplace_back(2.0 * u * u * u, v * v, 0.5 * (noise(i, 12, 2) + 1.0));
+    weights.push_back(1.0 + static_cast<double>(i % 3));
+    if (static_cast<int>(mix64(i) % static_cast<std::uint64_t>(world->size())) == world->rank()) {
+      part.push_back(all.back());
+      part_weights.push_back(weights.back());
+    }
+  }
+  const int leaves = 6;
+  const BisectionTree one = BisectionTree::balanced(self_communicator(), domain, leaves,
+                                                    {false, false, false}, all, weights);
+  const BisectionTree shared =
+      BisectionTree::balanced(*world, domain, leaves, {false, false, false}, part, part_weights);
+  std::vector<double> load(leaves);
+  for (int r = 0; r < leaves; ++r) {
+    EXPECT_TRUE(one.subdomain(r).min() == shared.subdomain(r).min()) << r;
+    EXPECT_TRUE(one.subdomain(r).max() == shared.subdomain(r).max()) << r;
+  }
+  for (std::size_t i = 0; i < all.size(); ++i) {
+    load[static_cast<std::size_t>(one.owner_of(all[i]))] += weights[i];
+  }
+  for (const double w : load) EXPECT_NEAR(w, 9999.0 / leaves, 6.0);
 }
 
 // A column of four spheres on the floor, standing across the boundaries between processes (one

@@ -12,20 +12,26 @@
 
 namespace grbd::parallel {
 
-// [balanced grid]
-CartesianGrid balanced_grid(const Communicator& comm, const Box& domain,
-                            const std::array<int, 3>& dims, const std::array<bool, 3>& periodic,
-                            std::span<const Vector3> centres, std::span<const double> weights) {
+void require_weights(std::span<const Vector3> centres, std::span<const double> weights,
+                     const char* where) {
   if (centres.size() != weights.size()) {
-    throw InvalidArgument("balanced_grid: expected one weight per centre, found " +
+    throw InvalidArgument(std::string(where) + ": expected one weight per centre, found " +
                           std::to_string(weights.size()) + " for " +
                           std::to_string(centres.size()));
   }
   for (const double w : weights) {
     if (!(w >= 0.0) || !std::isfinite(w)) {
-      throw InvalidArgument("balanced_grid: expected weights >= 0, found " + std::to_string(w));
+      throw InvalidArgument(std::string(where) + ": expected weights >= 0, found " +
+                            std::to_string(w));
     }
   }
+}
+
+// [balanced grid]
+CartesianGrid balanced_grid(const Communicator& comm, const Box& domain,
+                            const std::array<int, 3>& dims, const std::array<bool, 3>& periodic,
+                            std::span<const Vector3> centres, std::span<const double> weights) {
+  require_weights(centres, weights, "balanced_grid");
   const CartesianGrid even(domain, dims, periodic);  // checks domain and dims
   // The bisection of every cut of every axis at once: [lo, hi] brackets each cut.
   struct Cut {

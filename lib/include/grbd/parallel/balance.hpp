@@ -11,6 +11,11 @@
 
 namespace grbd::parallel {
 
+/// Throws InvalidArgument, naming `where`, unless there is one weight per centre and every weight
+/// is finite and ≥ 0: the check of the bodies a balance is computed from.
+void require_weights(std::span<const Vector3> centres, std::span<const double> weights,
+                     const char* where);
+
 /// The grid of `dims` subdomains over `domain` whose boundaries along each axis d cut the weighted
 /// distribution of the bodies' centres along d into n_d equal parts: b^d_k is where the weight of
 /// the centres below it reaches k/n_d of the whole (the weighted quantiles of each axis — recursive
