@@ -182,11 +182,8 @@ void write_temporary(const Communicator& comm, const std::filesystem::path& temp
     for (int d = 0; d < 3; ++d) warm[k].lambda[d] = s.warm_lambda[k][d];
   }
   if (comm.size() > 1) {
-    collective::sort_across(comm, bodies, [](const timestep::PackedBody& row) {
-      std::uint64_t id = 0;
-      std::memcpy(&id, row.data() + timestep::packed::id, sizeof id);
-      return id;
-    });
+    collective::sort_across(
+        comm, bodies, [](const timestep::PackedBody& row) { return timestep::packed_id(row); });
     collective::sort_across(comm, warm, [](const WarmRow& w) { return w.key; });
     warm.erase(std::unique(warm.begin(), warm.end(),
                            [](const WarmRow& a, const WarmRow& b) { return a.key == b.key; }),

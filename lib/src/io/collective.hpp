@@ -9,6 +9,7 @@
 #include <cstring>
 #include <exception>
 #include <new>
+#include <span>
 #include <string>
 #include <type_traits>
 #include <vector>
@@ -37,6 +38,30 @@ inline Block block_of(const Communicator& comm, std::uint64_t count) {
     block.total += n;
   }
   return block;
+}
+
+/// One message to every process, this one included, and one from each (collective): `send[r]`
+/// goes to rank r, `received[r]` comes from it.
+inline void exchange_with_all(const Communicator& comm,
+                              std::span<const std::vector<std::byte>> send,
+                              std::vector<std::vector<std::byte>>& received) {
+  std::vector<int> everyone(static_cast<std::size_t>(comm.size()));
+  for (int r = 0; r < comm.size(); ++r) everyone[static_cast<std::size_t>(r)] = r;
+  comm.exchange(everyone, send, received);
+}
+
+/// The rows of messages of trivially copyable rows, in the order of the messages and of the rows
+/// in each.
+template <class Row>
+std::vector<Row> rows_of(const std::vector<std::vector<std::byte>>& messages) {
+  static_assert(std::is_trivially_copyable_v<Row>);
+  std::vector<Row> rows;
+  for (const std::vector<std::byte>& part : messages) {
+    const std::size_t at = rows.size();
+    rows.resize(at + part.size() / sizeof(Row));
+    if (!part.empty()) std::memcpy(rows.data() + at, part.data(), part.size());
+  }
+  return rows;
 }
 
 // [sort across]
@@ -69,12 +94,7 @@ Block sort_across(const Communicator& comm, std::vector<Row>& rows, KeyOf key_of
   }
   std::vector<std::vector<std::byte>> all;
   comm.all_gather(std::as_bytes(std::span(mine)), all);
-  std::vector<Sample> samples;
-  for (const std::vector<std::byte>& part : all) {
-    const std::size_t at = samples.size();
-    samples.resize(at + part.size() / sizeof(Sample));
-    if (!part.empty()) std::memcpy(samples.data() + at, part.data(), part.size());
-  }
+  std::vector<Sample> samples = rows_of<Sample>(all);
   std::sort(samples.begin(), samples.end(),
             [](const Sample& a, const Sample& b) { return a.key < b.key; });
   double weight = 0.0;
@@ -108,16 +128,9 @@ Block sort_across(const Communicator& comm, std::vector<Row>& rows, KeyOf key_of
     if (last > first) std::memcpy(out.data(), rows.data() + first, out.size());
     first = last;
   }
-  std::vector<int> everyone(static_cast<std::size_t>(P));
-  for (int r = 0; r < P; ++r) everyone[static_cast<std::size_t>(r)] = r;
   std::vector<std::vector<std::byte>> received;
-  comm.exchange(everyone, send, received);
-  rows.clear();
-  for (const std::vector<std::byte>& part : received) {
-    const std::size_t begin = rows.size();
-    rows.resize(begin + part.size() / sizeof(Row));
-    if (!part.empty()) std::memcpy(rows.data() + begin, part.data(), part.size());
-  }
+  exchange_with_all(comm, send, received);
+  rows = rows_of<Row>(received);
   std::sort(rows.begin(), rows.end(), less);
   return block_of(comm, rows.size());
 }

@@ -495,12 +495,8 @@ void OutputFile::write_bodies(std::vector<timestep::BodyRecord>& created) {
   h5::pack_rows(created, o.packed_bodies);
   created.clear();
   auto& rows = o.packed_bodies;
-  const collective::Block block =
-      collective::sort_across(*o.comm, rows, [](const timestep::PackedBody& row) {
-        std::uint64_t id = 0;
-        std::memcpy(&id, row.data() + timestep::packed::id, sizeof id);
-        return id;
-      });
+  const collective::Block block = collective::sort_across(
+      *o.comm, rows, [](const timestep::PackedBody& row) { return timestep::packed_id(row); });
   if (block.total == 0) return;
   h5::resize(o.bodies.get(), written_.bodies + block.total, o.file, "bodies");
   h5::write_at(o.bodies.get(), o.body_type.get(), written_.bodies + block.offset, rows.size(), 0,

@@ -19,6 +19,7 @@
 #include "grbd/io/checkpoint.hpp"
 #include "grbd/io/output.hpp"
 #include "grbd/parallel/mpi.hpp"
+#include "io/collective.hpp"
 
 namespace grbd::parallel {
 
@@ -94,25 +95,13 @@ void agreed(const Communicator& comm, Work&& work) {
 }
 // [agreed]
 
-// Trivially copyable rows into one message per process, and the messages back into rows (in rank
-// order, each message's rows in the order they were sent).
+// A trivially copyable row appended to a message.
 template <class Row>
 void put(std::vector<std::byte>& out, const Row& row) {
   static_assert(std::is_trivially_copyable_v<Row>);
   const std::size_t at = out.size();
   out.resize(at + sizeof(Row));
   std::memcpy(out.data() + at, &row, sizeof(Row));
-}
-
-template <class Row>
-std::vector<Row> rows_of(const std::vector<std::vector<std::byte>>& received) {
-  std::vector<Row> rows;
-  for (const std::vector<std::byte>& part : received) {
-    const std::size_t at = rows.size();
-    rows.resize(at + part.size() / sizeof(Row));
-    if (!part.empty()) std::memcpy(rows.data() + at, part.data(), part.size());
-  }
-  return rows;
 }
 
 // [send to owners]
@@ -125,8 +114,6 @@ void send_to_owners(const Communicator& comm, const SceneDecomposition& decompos
                     scene::SimulationState& state) {
   const int P = comm.size();
   if (P == 1) return;
-  std::vector<int> everyone(static_cast<std::size_t>(P));
-  for (int r = 0; r < P; ++r) everyone[static_cast<std::size_t>(r)] = r;
   const auto to = [&](std::uint64_t id) { return static_cast<std::size_t>(id % std::uint64_t(P)); };
   struct Owner {
     std::uint64_t id;
@@ -135,10 +122,9 @@ void send_to_owners(const Communicator& comm, const SceneDecomposition& decompos
   struct Warm {
     timestep::ContactKey key;
     double lambda[3];
-    std::int64_t rank;  // the process that solves it, once known
   };
-  std::vector<std::vector<std::byte>> bodies(everyone.size()), owners(everyone.size()),
-      warm(everyone.size()), received;
+  const auto n = static_cast<std::size_t>(P);
+  std::vector<std::vector<std::byte>> bodies(n), owners(n), warm(n), received;
   timestep::PackedBody packed;
   for (const timestep::BodyRecord& body : state.bodies) {
     const int owner = decomposition.owner(body.state.q.head<3>());
@@ -152,24 +138,24 @@ void send_to_owners(const Communicator& comm, const SceneDecomposition& decompos
   for (std::size_t k = 0; k < state.warm_keys.size(); ++k) {
     const Vector3& l = state.warm_lambda[k];
     const timestep::ContactKey& key = state.warm_keys[k];
-    put(warm[to(solver_side(key))], Warm{key, {l[0], l[1], l[2]}, -1});
+    put(warm[to(solver_side(key))], Warm{key, {l[0], l[1], l[2]}});
   }
-  comm.exchange(everyone, bodies, received);
+  io::collective::exchange_with_all(comm, bodies, received);
   state.bodies.clear();
-  for (const timestep::PackedBody& row : rows_of<timestep::PackedBody>(received)) {
+  for (const timestep::PackedBody& row : io::collective::rows_of<timestep::PackedBody>(received)) {
     state.bodies.push_back(timestep::unpack(row));
   }
   // The directory: the owner of each body whose id it holds, and the warm starts of those ids.
-  comm.exchange(everyone, owners, received);
+  io::collective::exchange_with_all(comm, owners, received);
   const std::vector<Owner> directory = [&] {
-    std::vector<Owner> d = rows_of<Owner>(received);
+    std::vector<Owner> d = io::collective::rows_of<Owner>(received);
     std::sort(d.begin(), d.end(), [](const Owner& a, const Owner& b) { return a.id < b.id; });
     return d;
   }();
-  comm.exchange(everyone, warm, received);
-  std::vector<Warm> rows = rows_of<Warm>(received);
+  io::collective::exchange_with_all(comm, warm, received);
+  std::vector<Warm> rows = io::collective::rows_of<Warm>(received);
   for (std::vector<std::byte>& out : warm) out.clear();
-  for (Warm& w : rows) {
+  for (const Warm& w : rows) {
     const std::uint64_t id = solver_side(w.key);
     const auto it = std::lower_bound(directory.begin(), directory.end(), id,
                                      [](const Owner& o, std::uint64_t x) { return o.id < x; });
@@ -177,10 +163,10 @@ void send_to_owners(const Communicator& comm, const SceneDecomposition& decompos
     if (it == directory.end() || it->id != id) continue;
     put(warm[static_cast<std::size_t>(it->rank)], w);
   }
-  comm.exchange(everyone, warm, received);
+  io::collective::exchange_with_all(comm, warm, received);
   state.warm_keys.clear();
   state.warm_lambda.clear();
-  for (const Warm& w : rows_of<Warm>(received)) {
+  for (const Warm& w : io::collective::rows_of<Warm>(received)) {
     state.warm_keys.push_back(w.key);
     state.warm_lambda.emplace_back(w.lambda[0], w.lambda[1], w.lambda[2]);
   }

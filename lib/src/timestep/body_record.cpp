@@ -25,8 +25,8 @@ T get(std::span<const std::byte, kPackedBodyBytes> bytes, std::size_t offset) {
   return value;
 }
 
-void put_doubles(std::span<std::byte, kPackedBodyBytes> bytes, std::size_t offset,
-                 const double* x, std::size_t n) {
+void put_doubles(std::span<std::byte, kPackedBodyBytes> bytes, std::size_t offset, const double* x,
+                 std::size_t n) {
   std::memcpy(bytes.data() + offset, x, n * sizeof(double));
 }
 
@@ -42,13 +42,16 @@ void pack(const BodyRecord& record, std::span<std::byte, kPackedBodyBytes> bytes
   const collision::ShapeKind kind = collision::kind(record.shape);
   if (kind != collision::ShapeKind::sphere && kind != collision::ShapeKind::box &&
       kind != collision::ShapeKind::capsule) {
-    throw InvalidArgument("pack (body " + std::to_string(record.id) + "): expected a sphere, a "
+    throw InvalidArgument("pack (body " + std::to_string(record.id) +
+                          "): expected a sphere, a "
                           "box or a capsule, found a " +
                           std::string(collision::kind_name(kind)));
   }
   if ((record.flags & ~kDynamic) != 0) {
-    throw InvalidArgument("pack (body " + std::to_string(record.id) + "): expected the flags "
-                          "kDynamic or none, found " + std::to_string(record.flags));
+    throw InvalidArgument("pack (body " + std::to_string(record.id) +
+                          "): expected the flags "
+                          "kDynamic or none, found " +
+                          std::to_string(record.flags));
   }
   std::fill(bytes.begin(), bytes.begin() + kPackedConstantsBytes, std::byte{0});
   put(bytes, packed::id, record.id);
@@ -71,13 +74,18 @@ void pack(const BodyRecord& record, std::span<std::byte, kPackedBodyBytes> bytes
 }
 // [pack]
 
+GlobalId packed_id(std::span<const std::byte, kPackedBodyBytes> bytes) {
+  return get<std::uint64_t>(bytes, packed::id);
+}
+
 BodyRecord unpack(std::span<const std::byte, kPackedBodyBytes> bytes) {
   BodyRecord record;
   record.id = get<std::uint64_t>(bytes, packed::id);
   const auto shape = get<std::uint8_t>(bytes, packed::shape);
   const auto fixed = get<std::uint8_t>(bytes, packed::fixed);
   if (shape > static_cast<std::uint8_t>(collision::ShapeKind::capsule) || fixed > 1) {
-    throw InvalidArgument("unpack (body " + std::to_string(record.id) + "): expected a shape "
+    throw InvalidArgument("unpack (body " + std::to_string(record.id) +
+                          "): expected a shape "
                           "code 0–2 (sphere, box, capsule) and a fixed byte 0 or 1, found " +
                           std::to_string(shape) + " and " + std::to_string(fixed));
   }

@@ -27,14 +27,15 @@ inline constexpr GlobalId kStaticTag = GlobalId{1} << 63;
 /// Flags of a body, one byte per body.
 enum BodyFlags : std::uint8_t {
   kDynamic = 1U << 0,  ///< moves under forces and contacts; without it the body is fixed (u = 0)
-  kOwned = 1U << 1,    ///< owned by this process (BodySystem rows below owned_count()); ghosts lack it
+  kOwned =
+      1U << 1,  ///< owned by this process (BodySystem rows below owned_count()); ghosts lack it
 };
 
 /// Everything that describes one body: what BodySystem::add() takes and BodySystem::record()
 /// gives, what a scene's generators make, and what the output and a checkpoint store.
 // [body record]
 struct BodyRecord {
-  GlobalId id = 0;                ///< stable identity, unique in the system, < kStaticTag
+  GlobalId id = 0;  ///< stable identity, unique in the system, < kStaticTag
   /// The collision shape, centred at S with its axes along K: a sphere, a box or a capsule.
   collision::Shape shape = collision::Sphere{};
   body::RigidBody inertia;        ///< mass and principal moments (frame K is principal)
@@ -80,6 +81,8 @@ void pack(const BodyRecord& record, std::span<std::byte, kPackedBodyBytes> bytes
 /// code other than 0–2 or a fixed byte other than 0 or 1 (bytes that pack() did not write); the
 /// values themselves are checked where the record is used (BodySystem::add()).
 BodyRecord unpack(std::span<const std::byte, kPackedBodyBytes> bytes);
+/// The global id of packed bytes (what unpack() would give as `id`, without the rest).
+GlobalId packed_id(std::span<const std::byte, kPackedBodyBytes> bytes);
 /// True when two records describe the same body, state aside: every constant equal, bit for bit.
 bool same_constants(const BodyRecord& a, const BodyRecord& b);
 
