@@ -21,9 +21,11 @@ namespace {
 void require_extent(const Vector3& extent, const char* where) {
   for (int d = 0; d < 3; ++d) {
     if (!(extent[d] > 0.0) || !std::isfinite(extent[d])) {
-      throw InvalidArgument(std::string(where) + ": expected a domain of positive, finite extent, "
-                            "found " + format_number(extent[0]) + " × " +
-                            format_number(extent[1]) + " × " + format_number(extent[2]) + " m");
+      throw InvalidArgument(std::string(where) +
+                            ": expected a domain of positive, finite extent, "
+                            "found " +
+                            format_number(extent[0]) + " × " + format_number(extent[1]) + " × " +
+                            format_number(extent[2]) + " m");
     }
   }
 }
@@ -54,27 +56,16 @@ std::array<int, 3> grid_dims(int processes, const Vector3& extent) {
   return best;
 }
 
-namespace {
-
-// A grid's domain: finite, with a positive extent along every axis.
-void require_domain(const Box& domain) {
-  if (!domain.min().allFinite() || !domain.max().allFinite()) {
-    throw InvalidArgument("CartesianGrid: expected a finite domain");
-  }
-  require_extent(domain.sizes(), "CartesianGrid");
-}
-
-}  // namespace
-
 CartesianGrid::CartesianGrid(const Box& domain, const std::array<int, 3>& dims,
                              const std::array<bool, 3>& periodic)
-    : domain_(domain), dims_(dims), periodic_(periodic) {
-  require_domain(domain);
+    : Partition(domain, periodic, "CartesianGrid"), dims_(dims) {
   for (int d = 0; d < 3; ++d) {
     if (dims[d] < 1) {
-      throw InvalidArgument("CartesianGrid: expected at least one subdomain along each axis, "
-                            "found " + std::to_string(dims[0]) + " × " + std::to_string(dims[1]) +
-                            " × " + std::to_string(dims[2]));
+      throw InvalidArgument(
+          "CartesianGrid: expected at least one subdomain along each axis, "
+          "found " +
+          std::to_string(dims[0]) + " × " + std::to_string(dims[1]) + " × " +
+          std::to_string(dims[2]));
     }
     std::vector<double>& b = boundaries_[d];
     b.resize(static_cast<std::size_t>(dims[d]) + 1);
@@ -84,13 +75,12 @@ CartesianGrid::CartesianGrid(const Box& domain, const std::array<int, 3>& dims,
                        : domain.min()[d] + (domain.max()[d] - domain.min()[d]) * i / dims[d];
     }
   }
-  make_shifts();
 }
 
-CartesianGrid::CartesianGrid(const Box& domain, const std::array<std::vector<double>, 3>& boundaries,
+CartesianGrid::CartesianGrid(const Box& domain,
+                             const std::array<std::vector<double>, 3>& boundaries,
                              const std::array<bool, 3>& periodic)
-    : domain_(domain), periodic_(periodic), boundaries_(boundaries) {
-  require_domain(domain);
+    : Partition(domain, periodic, "CartesianGrid"), boundaries_(boundaries) {
   for (int d = 0; d < 3; ++d) {
     const std::vector<double>& b = boundaries_[d];
     bool valid = b.size() >= 2 && b.front() == domain.min()[d] && b.back() == domain.max()[d];
@@ -101,26 +91,6 @@ CartesianGrid::CartesianGrid(const Box& domain, const std::array<std::vector<dou
     }
     dims_[d] = static_cast<int>(b.size()) - 1;
   }
-  make_shifts();
-}
-
-void CartesianGrid::make_shifts() {
-  shifts_.push_back({0, 0, 0});
-  for (int sz = -1; sz <= 1; ++sz) {
-    for (int sy = -1; sy <= 1; ++sy) {
-      for (int sx = -1; sx <= 1; ++sx) {
-        const bool none = sx == 0 && sy == 0 && sz == 0;
-        if (none || (sx && !periodic_[0]) || (sy && !periodic_[1]) || (sz && !periodic_[2]))
-          continue;
-        shifts_.push_back({sx, sy, sz});
-      }
-    }
-  }
-}
-
-Vector3 CartesianGrid::shift(const std::array<int, 3>& s) const {
-  const Vector3 L = domain_.sizes();
-  return Vector3(s[0] * L.x(), s[1] * L.y(), s[2] * L.z());
 }
 
 std::array<int, 3> CartesianGrid::cell_of(int rank) const {
@@ -145,30 +115,6 @@ Box CartesianGrid::subdomain(int rank) const {
   return Box(lo, hi);
 }
 
-Box CartesianGrid::owned_region(int rank) const {
-  Box box = subdomain(rank);
-  const std::array<int, 3> c = cell_of(rank);
-  constexpr double kInfinity = std::numeric_limits<double>::infinity();
-  for (int d = 0; d < 3; ++d) {
-    if (periodic_[d]) continue;
-    if (c[d] == 0) box.min()[d] = -kInfinity;
-    if (c[d] == dims_[d] - 1) box.max()[d] = kInfinity;
-  }
-  return box;
-}
-
-Vector3 CartesianGrid::wrap(const Vector3& position) const {
-  Vector3 x = position;
-  for (int d = 0; d < 3; ++d) {
-    if (!periodic_[d]) continue;
-    const double lo = domain_.min()[d];
-    const double length = domain_.max()[d] - lo;
-    x[d] -= length * std::floor((x[d] - lo) / length);
-    if (x[d] >= domain_.max()[d]) x[d] = lo;  // x a hair below lo rounds up to max
-  }
-  return x;
-}
-
 int CartesianGrid::owner_of(const Vector3& position) const {
   // EXERCISE 8.1: the owner of a position
   // Hint: wrap() the position; along each axis d count the interior boundaries b_1 … b_{n−1}
@@ -177,27 +123,6 @@ int CartesianGrid::owner_of(const Vector3& position) const {
   throw grbd::NotImplemented("Exercise 8.1", "the owner of a position",
                              "Chapter 8: Parallel chute flow",
                              "exercises/08-parallel-chute-flow/decomposition.cpp");
-}
-
-std::vector<int> CartesianGrid::neighbours(int rank, double reach) const {
-  if (!(reach >= 0.0) || !std::isfinite(reach)) {
-    throw InvalidArgument("CartesianGrid::neighbours: expected a finite reach >= 0, found " +
-                          format_number(reach));
-  }
-  const Box mine = subdomain(rank);
-  std::vector<int> found;
-  for (int other = 0; other < size(); ++other) {
-    const Box box = subdomain(other);
-    // The subdomain and its images, shifted by −L, 0, +L along each periodic axis.
-    for (const std::array<int, 3>& s : shifts_) {
-      if (other == rank && s == shifts_.front()) continue;  // this subdomain itself
-      const Vector3 d = shift(s);
-      if (mine.exteriorDistance(Box(box.min() + d, box.max() + d)) <= reach) found.push_back(other);
-    }
-  }
-  std::sort(found.begin(), found.end());
-  found.erase(std::unique(found.begin(), found.end()), found.end());
-  return found;
 }
 
 bool overlaps(const Vector3& centre, double reach, const Box& box) {

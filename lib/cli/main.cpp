@@ -262,9 +262,10 @@ int run_command(const std::string& scene_file, const std::optional<std::string>&
               << std::setprecision(3) << result.seconds << " s (output and checkpoints "
               << 100.0 * result.output_seconds / std::max(result.seconds, 1e-300) << " %"
               << (world.size() > 1 ? ", " + std::to_string(world.size()) + " processes" : "")
-              << "), "
-              << result.records << " records in " << options.output.string() << ", checkpoint "
-              << options.checkpoint.string() << '\n';
+              << (result.rebalances > 0 ? ", " + std::to_string(result.rebalances) + " rebalances"
+                                        : "")
+              << "), " << result.records << " records in " << options.output.string()
+              << ", checkpoint " << options.checkpoint.string() << '\n';
   }
   if (result.stop_file) return kExitStopFile;
   if (result.interrupted) return 128 + static_cast<int>(g_signal);

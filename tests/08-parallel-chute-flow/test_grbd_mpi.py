@@ -129,6 +129,22 @@ class BitIdentical(Runs):
                 checksums.add(int(f.attrs["checksum"]))
         self.assertEqual(len(checksums), 1, checksums)
 
+    def test_a_bisection_tree_of_3_and_5_processes_writes_the_serial_output(self):
+        # Recursive coordinate bisection instead of the grid: leaves that do not line up, rebalanced
+        # every 10 steps as the lattice flies out and the stream flies in.
+        with open(BALLISTIC) as f:
+            text = f.read()
+        scene = self.path("tree.toml")
+        with open(scene, "w") as f:
+            f.write(text + '\n[parallel]\npartition = "bisection"\nrebalance_every = 10\n'
+                    'imbalance = 1.05\n')
+        self.run_ok(0, "run", scene, "-q", "-o", self.path("ts.h5"), "-c", self.path("ts.c.h5"))
+        for p in (3, 5):
+            out = self.path(f"t{p}.h5")
+            result = self.run_ok(p, "run", scene, "-o", out, "-c", self.path(f"t{p}.c.h5"))
+            self.assertRegex(result.stdout, r"[1-9]\d* rebalances")  # the tree was re-cut
+            self.assert_same_output(self.path("ts.h5"), out)
+
     def test_a_run_restarted_on_4_then_2_then_1_processes_continues_bit_for_bit(self):
         reference = self.serial()
         out, ckpt = self.path("r.h5"), self.path("r.c.h5")
@@ -183,7 +199,7 @@ class Failures(Runs):
             text = f.read()
         for bad, key in (("rebalance_every = -1", "rebalance_every"),
                          ("imbalance = 0.5", "imbalance"), ("average_every = 0", "average_every"),
-                         ("rebalance = 10", "unknown key")):
+                         ("rebalance = 10", "unknown key"), ('partition = "tree"', "partition")):
             with open(self.path("bad.toml"), "w") as f:
                 f.write(text + "\n[parallel]\n" + bad + "\n")
             result = grbd(2, "run", self.path("bad.toml"), "-o", self.path("bad.h5"), timeout=120)

@@ -206,7 +206,7 @@ Everyone gather(const timestep::BodySystem& system) {
 
 // Every ghost this process must hold, from everyone's bodies, without the exchange's shortcuts:
 // each body, each periodic shift, tested against this subdomain.
-void expect_exact_ghosts(const timestep::BodySystem& system, const CartesianGrid& grid,
+void expect_exact_ghosts(const timestep::BodySystem& system, const Partition& grid,
                          double max_radius, double margin, const Everyone& all) {
   const int me = world->rank();
   const Box mine = grid.subdomain(me);
@@ -241,11 +241,11 @@ void expect_exact_ghosts(const timestep::BodySystem& system, const CartesianGrid
   EXPECT_EQ(system.ghost_count(), expected) << "rank " << me;
 }
 
-TEST(BodyExchange, MigrationAndBordersKeepEveryBodyOnceAndEveryGhostExact) {
+// 400 beads in random motion through a box periodic along x and y, cut by `grid`.
+void expect_every_body_once_and_every_ghost_exact(const Partition& grid) {
   const int p = world->size();
   const int me = world->rank();
-  const Box domain(Vector3(0.0, 0.0, 0.0), Vector3(1.0, 0.6, 0.4));
-  const CartesianGrid grid(domain, grid_dims(p, domain.sizes()), {true, true, false});
+  const Box& domain = grid.domain();
   const double margin = 0.02;
   const std::uint64_t n = 400;
   timestep::BodySystem system;
@@ -278,7 +278,7 @@ TEST(BodyExchange, MigrationAndBordersKeepEveryBodyOnceAndEveryGhostExact) {
       ASSERT_TRUE(c.x() >= 0.0 && c.x() < 1.0 && c.y() >= 0.0 && c.y() < 0.6);  // wrapped
     }
     expect_exact_ghosts(system, grid, 0.03, margin, all);
-    if (HasFatalFailure()) return;
+    if (::testing::Test::HasFatalFailure()) return;
     // Forward: the owners move a little (no migration) and change their velocities; the ghosts
     // follow, bit for bit.
     for (std::size_t i = 0; i < system.owned_count(); ++i) {
@@ -299,6 +299,19 @@ TEST(BodyExchange, MigrationAndBordersKeepEveryBodyOnceAndEveryGhostExact) {
     system.remove(first);
     EXPECT_THROW(exchange.forward(system), InvalidArgument);
   }
+}
+
+TEST(BodyExchange, MigrationAndBordersKeepEveryBodyOnceAndEveryGhostExact) {
+  const Box domain(Vector3(0.0, 0.0, 0.0), Vector3(1.0, 0.6, 0.4));
+  expect_every_body_once_and_every_ghost_exact(
+      CartesianGrid(domain, grid_dims(world->size(), domain.sizes()), {true, true, false}));
+}
+
+// The same through the leaves of a bisection tree, whose boxes do not line up in a grid.
+TEST(BodyExchange, MigrationAndBordersThroughABisectionTreeKeepEveryBodyOnceAndEveryGhostExact) {
+  const Box domain(Vector3(0.0, 0.0, 0.0), Vector3(1.0, 0.6, 0.4));
+  expect_every_body_once_and_every_ghost_exact(
+      BisectionTree(domain, world->size(), {true, true, false}));
 }
 
 TEST(BodyExchange, ImageCodesRoundTrip) {
@@ -337,7 +350,7 @@ timestep::MaterialTable glass() {
 
 // A column of n spheres of radius r standing on the floor at (x, y), moving with v: the ones this
 // process owns.
-void add_column(timestep::BodySystem& mine, const CartesianGrid& grid, int n, double r,
+void add_column(timestep::BodySystem& mine, const Partition& grid, int n, double r,
                 const Vector3& base, const Vector3& v) {
   for (std::uint64_t k = 0; k < static_cast<std::uint64_t>(n); ++k) {
     const Vector3 c = base + Vector3(0.0, 0.0, r + 2.0 * r * static_cast<double>(k));
@@ -368,7 +381,7 @@ timestep::StepSettings resting(double r) {
 // A flight of spheres of radius 5 mm with centres on a lattice, first at `origin`, `spacing` apart,
 // and velocities `drift` plus `spread` times a noise of their own: all of them in `serial`, those
 // this process owns in `mine`.
-void add_flight(timestep::BodySystem& serial, timestep::BodySystem& mine, const CartesianGrid& grid,
+void add_flight(timestep::BodySystem& serial, timestep::BodySystem& mine, const Partition& grid,
                 const std::array<int, 3>& count, const Vector3& origin, const Vector3& spacing,
                 const Vector3& drift, double spread, int round) {
   std::uint64_t id = 1;
@@ -438,20 +451,18 @@ TEST(ParallelStepper, FreeFlightAcrossSubdomainsIsTheSerialRunBitForBit) {
 // steps the stepper looks at the balance and moves the grid's boundaries to the bodies' weighted
 // quantiles, and the bodies to their new owners — far beyond the neighbours. Free flight stays the
 // serial run bit for bit, no body is lost or duplicated, and the load ends balanced.
-TEST(ParallelStepper, RebalancingMovesTheBoundariesToTheBodiesAndKeepsTheSerialRun) {
+void expect_rebalancing_keeps_the_serial_run(const Partition& partition) {
   const int p = world->size();
-  const Box domain(Vector3(0, 0, 0), Vector3(1, 1, 1));
-  const CartesianGrid grid(domain, grid_dims(p, domain.sizes()));
   timestep::BodySystem serial;
   timestep::BodySystem mine;
-  add_flight(serial, mine, grid, {8, 6, 6}, Vector3(0.02, 0.1, 0.1), Vector3(0.03, 0.03, 0.03),
+  add_flight(serial, mine, partition, {8, 6, 6}, Vector3(0.02, 0.1, 0.1), Vector3(0.03, 0.03, 0.03),
              Vector3(0.5, 0.2, 0.1), 0.02, 9);
   const timestep::StaticGeometry statics;
   const timestep::MaterialTable materials = glass();
   timestep::MoreauStepper reference(serial, statics, materials, flight(0.004));
   ParallelSettings balanced{0.005};
   balanced.rebalance_every = 5;
-  ParallelStepper parallel(*world, grid, mine, statics, materials, flight(0.004), balanced);
+  ParallelStepper parallel(*world, partition, mine, statics, materials, flight(0.004), balanced);
   for (int step = 0; step < 60; ++step) {  // collective: no ASSERT inside, no early exit
     reference.step();
     parallel.step();
@@ -463,11 +474,25 @@ TEST(ParallelStepper, RebalancingMovesTheBoundariesToTheBodiesAndKeepsTheSerialR
     EXPECT_GE(parallel.rebalances(), 1u);
     // the bodies drift by less than a subdomain between two looks at the balance
     EXPECT_LE(most[0], 1.25 * static_cast<double>(serial.size()) / p);
-    EXPECT_GT(parallel.grid().boundaries(0)[1], 0.0);
-    EXPECT_LT(parallel.grid().boundaries(0)[1], 0.5);  // moved towards the crowd
+    // the first cut along x, between the crowd's start near 0.02 m and the middle
+    const double cut = parallel.partition().subdomain(0).max().x();
+    EXPECT_GT(cut, 0.0);
+    EXPECT_LT(cut, 0.5);  // moved towards the crowd
   } else {
     EXPECT_EQ(parallel.rebalances(), 0u);
   }
+}
+
+TEST(ParallelStepper, RebalancingMovesTheBoundariesToTheBodiesAndKeepsTheSerialRun) {
+  const Box domain(Vector3(0, 0, 0), Vector3(1, 1, 1));
+  expect_rebalancing_keeps_the_serial_run(
+      CartesianGrid(domain, grid_dims(world->size(), domain.sizes())));
+}
+
+// The same with recursive coordinate bisection: the tree's cuts follow the crowd.
+TEST(ParallelStepper, RebalancingMovesTheBisectionCutsToTheBodiesAndKeepsTheSerialRun) {
+  const Box domain(Vector3(0, 0, 0), Vector3(1, 1, 1));
+  expect_rebalancing_keeps_the_serial_run(BisectionTree(domain, world->size()));
 }
 
 // The balanced grid does not depend on how the bodies are spread over the processes: each process

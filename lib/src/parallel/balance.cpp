@@ -27,6 +27,13 @@ void require_weights(std::span<const Vector3> centres, std::span<const double> w
   }
 }
 
+std::unique_ptr<Partition> CartesianGrid::rebalanced(const Communicator& comm,
+                                                     std::span<const Vector3> centres,
+                                                     std::span<const double> weights) const {
+  return std::make_unique<CartesianGrid>(
+      balanced_grid(comm, domain(), dims(), periodic(), centres, weights));
+}
+
 // [balanced grid]
 CartesianGrid balanced_grid(const Communicator& comm, const Box& domain,
                             const std::array<int, 3>& dims, const std::array<bool, 3>& periodic,

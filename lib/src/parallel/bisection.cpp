@@ -5,10 +5,8 @@
 
 #include <algorithm>
 #include <cmath>
-#include <limits>
 #include <string>
 
-#include "grbd/core/checks.hpp"
 #include "grbd/core/error.hpp"
 #include "grbd/parallel/balance.hpp"
 
@@ -35,12 +33,7 @@ double inside(double cut, double lo, double hi) {
 }  // namespace
 
 BisectionTree::BisectionTree(const Box& domain, const std::array<bool, 3>& periodic)
-    : domain_(domain), periodic_(periodic) {
-  const Vector3 extent = domain.sizes();
-  if (!domain.min().allFinite() || !domain.max().allFinite() || !(extent.minCoeff() > 0.0)) {
-    throw InvalidArgument("BisectionTree: expected a finite domain of positive extent");
-  }
-}
+    : Partition(domain, periodic, "BisectionTree") {}
 
 BisectionTree::BisectionTree(const Box& domain, int processes, const std::array<bool, 3>& periodic)
     : BisectionTree(domain, periodic) {
@@ -179,8 +172,8 @@ BisectionTree BisectionTree::balanced(const Communicator& comm, const Box& domai
 // [bisection tree]
 
 void BisectionTree::make_leaves() {
-  leaves_.assign(static_cast<std::size_t>(nodes_.front().count), domain_);
-  std::vector<Box> boxes(nodes_.size(), domain_);
+  leaves_.assign(static_cast<std::size_t>(nodes_.front().count), domain());
+  std::vector<Box> boxes(nodes_.size(), domain());
   for (std::size_t k = 0; k < nodes_.size(); ++k) {
     const Node& node = nodes_[k];
     if (node.count == 1) {
@@ -195,7 +188,7 @@ void BisectionTree::make_leaves() {
   }
 }
 
-const Box& BisectionTree::subdomain(int rank) const {
+Box BisectionTree::subdomain(int rank) const {
   if (rank < 0 || rank >= size()) {
     throw InvalidArgument("BisectionTree: expected a rank in [0, " + std::to_string(size()) +
                           "), found " + std::to_string(rank));
@@ -203,28 +196,7 @@ const Box& BisectionTree::subdomain(int rank) const {
   return leaves_[static_cast<std::size_t>(rank)];
 }
 
-Box BisectionTree::owned_region(int rank) const {
-  Box box = subdomain(rank);
-  const double infinity = std::numeric_limits<double>::infinity();
-  for (int d = 0; d < 3; ++d) {
-    if (periodic_[static_cast<std::size_t>(d)]) continue;
-    if (box.min()[d] == domain_.min()[d]) box.min()[d] = -infinity;
-    if (box.max()[d] == domain_.max()[d]) box.max()[d] = infinity;
-  }
-  return box;
-}
-
-Vector3 BisectionTree::wrap(const Vector3& position) const {
-  Vector3 p = position;
-  for (int d = 0; d < 3; ++d) {
-    if (!periodic_[static_cast<std::size_t>(d)]) continue;
-    const double lo = domain_.min()[d], L = domain_.max()[d] - lo;
-    p[d] = lo + (p[d] - lo - L * std::floor((p[d] - lo) / L));
-    if (p[d] >= domain_.max()[d]) p[d] = lo;  // rounding at the upper end
-  }
-  return p;
-}
-
+// [tree owner]
 int BisectionTree::owner_of(const Vector3& position) const {
   const Vector3 p = wrap(position);
   std::size_t k = 0;
@@ -234,36 +206,13 @@ int BisectionTree::owner_of(const Vector3& position) const {
   }
   return nodes_[k].first;
 }
+// [tree owner]
 
-std::vector<int> BisectionTree::neighbours(int rank, double reach) const {
-  if (!(reach >= 0.0) || !std::isfinite(reach)) {
-    throw InvalidArgument("BisectionTree::neighbours: expected a finite reach >= 0, found " +
-                          format_number(reach));
-  }
-  const Box& mine = subdomain(rank);
-  const Vector3 L = domain_.sizes();
-  std::vector<int> found;
-  for (int other = 0; other < size(); ++other) {
-    const Box& box = leaves_[static_cast<std::size_t>(other)];
-    // The leaf and its images, shifted by −L, 0, +L along each periodic axis.
-    for (int sz = -1; sz <= 1; ++sz) {
-      for (int sy = -1; sy <= 1; ++sy) {
-        for (int sx = -1; sx <= 1; ++sx) {
-          const int s[3] = {sx, sy, sz};
-          bool allowed = true;
-          for (int d = 0; d < 3; ++d) allowed = allowed && (s[d] == 0 || periodic_[d]);
-          if (!allowed || (other == rank && sx == 0 && sy == 0 && sz == 0)) continue;
-          const Vector3 shift(sx * L.x(), sy * L.y(), sz * L.z());
-          if (mine.exteriorDistance(Box(box.min() + shift, box.max() + shift)) <= reach) {
-            found.push_back(other);
-          }
-        }
-      }
-    }
-  }
-  std::sort(found.begin(), found.end());
-  found.erase(std::unique(found.begin(), found.end()), found.end());
-  return found;
+std::unique_ptr<Partition> BisectionTree::rebalanced(const Communicator& comm,
+                                                     std::span<const Vector3> centres,
+                                                     std::span<const double> weights) const {
+  return std::make_unique<BisectionTree>(
+      balanced(comm, domain(), size(), periodic(), centres, weights));
 }
 
 }  // namespace grbd::parallel

@@ -59,11 +59,11 @@ std::array<int, 3> image_shift(std::uint32_t code) {
   return {k % 3 - 1, (k / 3) % 3 - 1, k / 9 - 1};
 }
 
-BodyExchange::BodyExchange(const Communicator& comm, const CartesianGrid& grid, double margin,
+BodyExchange::BodyExchange(const Communicator& comm, const Partition& partition, double margin,
                            double max_radius)
-    : comm_(comm), grid_(grid), margin_(margin), max_radius_(max_radius) {
-  if (grid.size() != comm.size()) {
-    throw InvalidArgument("BodyExchange: the grid has " + std::to_string(grid.size()) +
+    : comm_(comm), partition_(partition), margin_(margin), max_radius_(max_radius) {
+  if (partition.size() != comm.size()) {
+    throw InvalidArgument("BodyExchange: the partition has " + std::to_string(partition.size()) +
                           " subdomains for " + std::to_string(comm.size()) + " processes");
   }
   if (!(margin >= 0.0) || !std::isfinite(margin)) {
@@ -71,7 +71,7 @@ BodyExchange::BodyExchange(const Communicator& comm, const CartesianGrid& grid, 
                           format_number(margin));
   }
   require_positive_finite("BodyExchange", "max_radius", max_radius);
-  neighbours_ = grid.neighbours(comm.rank(), 2.0 * max_radius + margin);
+  neighbours_ = partition.neighbours(comm.rank(), 2.0 * max_radius + margin);
   const std::size_t m = neighbours_.size();
   sent_.resize(m);
   ghost_start_.assign(m, 0);
@@ -90,9 +90,9 @@ std::size_t BodyExchange::migrate(timestep::BodySystem& system) {
   const auto states = system.states();
   for (std::size_t i = 0; i < system.owned_count(); ++i) {
     Vector3 c = states[i].q.head<3>();
-    const Vector3 wrapped = grid_.wrap(c);
+    const Vector3 wrapped = partition_.wrap(c);
     if (wrapped != c) states[i].q.head<3>() = wrapped;  // crossed a periodic boundary
-    const int owner = grid_.owner_of(wrapped);
+    const int owner = partition_.owner_of(wrapped);
     if (owner == me) continue;
     const auto k = std::lower_bound(neighbours_.begin(), neighbours_.end(), owner);
     if (k == neighbours_.end() || *k != owner) {
@@ -159,7 +159,7 @@ std::size_t BodyExchange::migrate(timestep::BodySystem& system, timestep::WarmSt
 std::size_t BodyExchange::borders(timestep::BodySystem& system) {
   system.clear_ghosts();
   const int me = comm_.rank();
-  const Box mine = grid_.owned_region(me);
+  const Box mine = partition_.owned_region(me);
   for (std::size_t k = 0; k < neighbours_.size(); ++k) {
     out_[k].clear();
     sent_[k].rows.clear();
@@ -174,11 +174,11 @@ std::size_t BodyExchange::borders(timestep::BodySystem& system) {
     const Vector3 inside = (c - mine.min()).cwiseMin(mine.max() - c);
     if (inside.minCoeff() > reach * (1.0 + 1e-12)) continue;
     for (std::size_t k = 0; k < neighbours_.size(); ++k) {
-      const Box box = grid_.owned_region(neighbours_[k]);
-      for (const std::array<int, 3>& s : grid_.image_shifts()) {
+      const Box box = partition_.owned_region(neighbours_[k]);
+      for (const std::array<int, 3>& s : partition_.image_shifts()) {
         const bool plain = s == std::array<int, 3>{0, 0, 0};
         if (plain && neighbours_[k] == me) continue;  // the body itself
-        if (!overlaps(c + grid_.shift(s), reach, box)) continue;
+        if (!overlaps(c + partition_.shift(s), reach, box)) continue;
         append_body(out_[k], system.record(i));
         const std::uint64_t code = image_code(s);
         append(out_[k], &code, sizeof code);
@@ -195,7 +195,7 @@ std::size_t BodyExchange::borders(timestep::BodySystem& system) {
       std::uint64_t code = 0;
       std::memcpy(&code, message.data() + at + timestep::kPackedBodyBytes, sizeof code);
       const auto image = static_cast<std::uint32_t>(code);
-      system.add_ghost(body_at(message, at), grid_.shift(image_shift(image)), image);
+      system.add_ghost(body_at(message, at), partition_.shift(image_shift(image)), image);
     }
     ghost_count_[k] = system.size() - ghost_start_[k];
     received += ghost_count_[k];
@@ -248,7 +248,7 @@ void BodyExchange::forward(timestep::BodySystem& system) {
       body::State& x = states[row];
       std::memcpy(x.q.data(), at, 7 * sizeof(double));
       std::memcpy(x.u.data(), at + 7 * sizeof(double), 6 * sizeof(double));
-      x.q.head<3>() += grid_.shift(image_shift(images[row]));
+      x.q.head<3>() += partition_.shift(image_shift(images[row]));
     }
   }
 }

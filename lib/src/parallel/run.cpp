@@ -18,6 +18,8 @@
 #include "grbd/core/checks.hpp"
 #include "grbd/io/checkpoint.hpp"
 #include "grbd/io/output.hpp"
+#include "grbd/parallel/bisection.hpp"
+#include "grbd/parallel/decomposition.hpp"
 #include "grbd/parallel/mpi.hpp"
 #include "io/collective.hpp"
 
@@ -184,6 +186,16 @@ double largest_radius(const scene::Scene& scene) {
   return r;
 }
 
+// The scene's partition of `box` for P processes, before any balance.
+std::unique_ptr<Partition> make_partition(int processes, const scene::Scene& scene,
+                                          const Box& box) {
+  const std::array<bool, 3>& periodic = scene.domain.periodic;
+  if (scene.parallel.partition == scene::ParallelSpec::Partition::bisection) {
+    return std::make_unique<BisectionTree>(box, processes, periodic);
+  }
+  return std::make_unique<CartesianGrid>(box, grid_dims(processes, box.sizes()), periodic);
+}
+
 }  // namespace
 
 Box decomposition_box(const scene::Scene& scene) {
@@ -198,7 +210,7 @@ SceneDecomposition::SceneDecomposition(const Communicator& comm, const scene::Sc
 SceneDecomposition::SceneDecomposition(const Communicator& comm, const scene::Scene& scene,
                                        const Box& box)
     : comm_(comm),
-      grid_(box, grid_dims(comm.size(), box.sizes()), scene.domain.periodic),
+      partition_(make_partition(comm.size(), scene, box)),
       parallel_{largest_radius(scene), scene.parallel.average_every, scene.parallel.rebalance_every,
                 scene.parallel.imbalance} {
   // A pair of bodies must not touch both directly and through a periodic boundary: the contact
@@ -223,8 +235,8 @@ std::unique_ptr<scene::StepEngine> SceneDecomposition::engine(
     const timestep::MaterialTable& materials, const timestep::StepSettings& settings) const {
   timestep::StepSettings s = settings;
   s.skin = skin_of(s);
-  auto engine =
-      std::make_unique<ParallelStepper>(comm_, grid_, system, statics, materials, s, parallel_);
+  auto engine = std::make_unique<ParallelStepper>(comm_, *partition_, system, statics, materials, s,
+                                                  parallel_);
   engine_ = engine.get();
   return engine;
 }
@@ -353,6 +365,7 @@ io::RunResult run(const scene::Scene& scene, const io::RunOptions& options,
   agreed(comm, [&] { output->close(sim); });
   if (root && result.stop_file) io::remove_stop_file(options);
   result.records = output->position().records;
+  result.rebalances = decomposition->rebalances();
   result.seconds = seconds_since(start);
   return result;
 }

@@ -12,11 +12,10 @@
 
 #include "grbd/core/checks.hpp"
 #include "grbd/core/error.hpp"
-#include "grbd/parallel/balance.hpp"
 
 namespace grbd::parallel {
 
-ParallelStepper::ParallelStepper(const Communicator& comm, const CartesianGrid& grid,
+ParallelStepper::ParallelStepper(const Communicator& comm, const Partition& partition,
                                  timestep::BodySystem& system,
                                  const timestep::StaticGeometry& statics,
                                  const timestep::MaterialTable& materials,
@@ -30,8 +29,8 @@ ParallelStepper::ParallelStepper(const Communicator& comm, const CartesianGrid& 
       imbalance_(parallel.imbalance),
       margin_(settings.contact_tolerance * settings.tolerance_radius + settings.skin),
       max_radius_(parallel.max_radius),
-      grid_(grid) {
-  exchange_.emplace(comm, grid_, margin_, max_radius_);
+      partition_(partition.clone()) {
+  exchange_.emplace(comm, *partition_, margin_, max_radius_);
   if (parallel.rebalance_every < 0 || !(parallel.imbalance >= 1.0)) {
     throw InvalidArgument(
         "ParallelStepper: expected rebalance_every >= 0 and imbalance >= 1, "
@@ -98,7 +97,8 @@ timestep::StepReport ParallelStepper::step() {
 // [rebalance]
 // At a rebuild, every rebalance_every steps: when the most loaded process carries more than
 // imbalance times the mean weight (1 per body, 1 per contact it took part in at the last step),
-// the grid becomes the balanced grid of the bodies, and every body moves to its new owner (an
+// the partition is rebalanced (Partition::rebalanced: the balanced grid, or the balanced bisection
+// tree, of the bodies), and every body moves to its new owner (an
 // exchange among all processes, which a rebalance may send a body to), with its warm starts.
 void ParallelStepper::rebalance_if_due() {
   const std::uint64_t step = stepper_->steps();
@@ -122,12 +122,13 @@ void ParallelStepper::rebalance_if_due() {
   if (!(largest[0] > imbalance_ * mean)) return;
   std::vector<Vector3> centres(n);
   for (std::size_t i = 0; i < n; ++i) centres[i] = system_.states()[i].q.head<3>();
-  grid_ = balanced_grid(comm_, grid_.domain(), grid_.dims(), grid_.periodic(), centres, weights);
+  exchange_.reset();  // it refers to the partition replaced here
+  partition_ = partition_->rebalanced(comm_, centres, weights);
   // Every process is a neighbour of every other for this one migration: a reach beyond the domain.
-  const double everywhere = 2.0 * grid_.domain().diagonal().norm() + margin_;
-  BodyExchange all(comm_, grid_, margin_, everywhere);
+  const double everywhere = 2.0 * partition_->domain().diagonal().norm() + margin_;
+  BodyExchange all(comm_, *partition_, margin_, everywhere);
   all.migrate(system_, stepper_->warm_starts());
-  exchange_.emplace(comm_, grid_, margin_, max_radius_);
+  exchange_.emplace(comm_, *partition_, margin_, max_radius_);
   ++rebalances_;
 }
 // [rebalance]

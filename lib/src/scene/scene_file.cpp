@@ -760,6 +760,8 @@ void read_checkpoint(TableReader& t, Scene& scene) {
 
 void read_parallel(TableReader& t, Scene& scene) {
   ParallelSpec& p = scene.parallel;
+  p.partition =
+      static_cast<ParallelSpec::Partition>(t.choice("partition", {"grid", "bisection"}, 0));
   p.average_every = static_cast<int>(t.integer("average_every", p.average_every, 1, 1'000'000));
   p.rebalance_every =
       static_cast<int>(t.integer("rebalance_every", p.rebalance_every, 0, 1'000'000'000));

@@ -93,6 +93,8 @@ struct RunResult {
   double seconds = 0.0;           ///< wall time of the run [s]
   double step_seconds = 0.0;      ///< of which in steps [s]
   double output_seconds = 0.0;    ///< of which writing records and checkpoints [s]
+  /// Times a run on many processes re-cut the domain to even the load (chapter 8; 0 serially).
+  std::uint64_t rebalances = 0;
 };
 
 /// Runs `scene` to its end_time (or until *stop): a record at step 0 (fresh runs), every

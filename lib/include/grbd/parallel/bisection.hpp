@@ -5,11 +5,12 @@
 /// cannot give when the load is uneven in more than one direction at once.
 
 #include <array>
+#include <memory>
 #include <span>
 #include <vector>
 
 #include "grbd/core/communicator.hpp"
-#include "grbd/parallel/decomposition.hpp"
+#include "grbd/parallel/partition.hpp"
 
 namespace grbd::parallel {
 
@@ -21,7 +22,7 @@ namespace grbd::parallel {
 /// leaf reached by the same descent, i.e. the nearest leaf along each non-periodic axis, and along
 /// a periodic axis it is wrapped into the domain first. Every process builds the same tree from the
 /// same numbers and so agrees on every owner.
-class BisectionTree {
+class BisectionTree final : public Partition {
  public:
   /// The tree of `processes` leaves whose cuts split the volume of each box in proportion to its
   /// processes (the even tree). Throws InvalidArgument for an empty or non-finite domain or fewer
@@ -40,24 +41,20 @@ class BisectionTree {
                                 const std::array<bool, 3>& periodic,
                                 std::span<const Vector3> centres, std::span<const double> weights);
 
+  /// A copy.
+  std::unique_ptr<Partition> clone() const override {
+    return std::make_unique<BisectionTree>(*this);
+  }
+  /// The balanced() tree of the bodies with as many leaves.
+  std::unique_ptr<Partition> rebalanced(const Communicator& comm, std::span<const Vector3> centres,
+                                        std::span<const double> weights) const override;
+
   /// Number of leaves (= processes).
-  int size() const { return static_cast<int>(leaves_.size()); }
-  /// The whole domain.
-  const Box& domain() const { return domain_; }
-  /// Whether each axis is periodic.
-  const std::array<bool, 3>& periodic() const { return periodic_; }
+  int size() const override { return static_cast<int>(leaves_.size()); }
   /// The box of a rank's leaf.
-  const Box& subdomain(int rank) const;
-  /// The region whose bodies a rank owns: its leaf, extended to ±∞ along each non-periodic axis
-  /// where it ends the domain.
-  Box owned_region(int rank) const;
+  Box subdomain(int rank) const override;
   /// The rank that owns a position (descent through the cuts of the wrapped position).
-  int owner_of(const Vector3& position) const;
-  /// The ranks whose leaf, or a periodic image of it, lies within `reach` of the leaf of `rank`,
-  /// sorted, each once; `rank` itself only through a periodic image. O(P) per call.
-  std::vector<int> neighbours(int rank, double reach) const;
-  /// A position moved into the domain along the periodic axes.
-  Vector3 wrap(const Vector3& position) const;
+  int owner_of(const Vector3& position) const override;
 
  private:
   struct Node {
@@ -69,8 +66,6 @@ class BisectionTree {
   BisectionTree(const Box& domain, const std::array<bool, 3>& periodic);
   // The leaves' boxes, from the nodes' cuts.
   void make_leaves();
-  Box domain_;
-  std::array<bool, 3> periodic_;
   std::vector<Node> nodes_;  // nodes_[0] is the root
   std::vector<Box> leaves_;  // by rank
 };

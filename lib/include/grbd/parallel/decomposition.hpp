@@ -3,18 +3,16 @@
 /// \brief The domain split among processes (chapter 8): a Cartesian grid of subdomains, the owner
 /// of a position, and whether a body reaches into a subdomain.
 
-#include <Eigen/Geometry>
 #include <array>
+#include <memory>
 #include <vector>
 
 #include "grbd/core/types.hpp"
+#include "grbd/parallel/partition.hpp"
 #include "grbd/timestep/body_system.hpp"
 #include "grbd/timestep/contacts.hpp"
 
 namespace grbd::parallel {
-
-/// An axis-aligned box [min, max] in frame I [m].
-using Box = Eigen::AlignedBox3d;
 
 /// The number of subdomains along x, y and z for `processes` processes over a domain of the given
 /// extents: of all factorisations n_x n_y n_z = P, the one whose interfaces between subdomains
@@ -29,7 +27,7 @@ std::array<int, 3> grid_dims(int processes, const Vector3& extent);
 /// and belongs to rank i + n_x (j + n_y k). A position outside the domain belongs to the nearest
 /// subdomain along each non-periodic axis; along a periodic axis it is wrapped into the domain
 /// first. Every process builds the same grid from the same numbers and so agrees on every owner.
-class CartesianGrid {
+class CartesianGrid final : public Partition {
  public:
   /// Throws InvalidArgument for an empty or non-finite domain, or dims < 1.
   CartesianGrid(const Box& domain, const std::array<int, 3>& dims,
@@ -41,14 +39,18 @@ class CartesianGrid {
   CartesianGrid(const Box& domain, const std::array<std::vector<double>, 3>& boundaries,
                 const std::array<bool, 3>& periodic = {false, false, false});
 
+  /// A copy.
+  std::unique_ptr<Partition> clone() const override {
+    return std::make_unique<CartesianGrid>(*this);
+  }
+  /// The balanced_grid() of the bodies with the same dims.
+  std::unique_ptr<Partition> rebalanced(const Communicator& comm, std::span<const Vector3> centres,
+                                        std::span<const double> weights) const override;
+
   /// Number of subdomains (= processes).
-  int size() const { return dims_[0] * dims_[1] * dims_[2]; }
+  int size() const override { return dims_[0] * dims_[1] * dims_[2]; }
   /// Subdomains along x, y, z.
   const std::array<int, 3>& dims() const { return dims_; }
-  /// The whole domain.
-  const Box& domain() const { return domain_; }
-  /// Whether each axis is periodic.
-  const std::array<bool, 3>& periodic() const { return periodic_; }
   /// The boundaries b^d_0 … b^d_{n_d} along axis d (the first and last are the domain's).
   const std::vector<double>& boundaries(int axis) const { return boundaries_[axis]; }
 
@@ -56,40 +58,18 @@ class CartesianGrid {
   std::array<int, 3> cell_of(int rank) const;
   int rank_of(const std::array<int, 3>& cell) const;  ///< i + n_x (j + n_y k)
   /// The box of a rank's subdomain.
-  Box subdomain(int rank) const;
-  /// The region whose bodies a rank owns: its subdomain, extended to ±∞ along each non-periodic
-  /// axis where it ends the domain (a body outside the domain belongs to the nearest subdomain,
-  /// and its ghosts must go where its contacts are, also beyond the domain).
-  Box owned_region(int rank) const;
+  Box subdomain(int rank) const override;
 
-  /// The shifts s ∈ {−1, 0, 1}³, in periods, that the periodic axes allow — the images of a
-  /// position or a subdomain — (0, 0, 0) first.
-  const std::vector<std::array<int, 3>>& image_shifts() const { return shifts_; }
-  /// The displacement of a shift in periods: s_d L_d along each axis [m].
-  Vector3 shift(const std::array<int, 3>& s) const;
-
-  /// A position moved into the domain along the periodic axes (unchanged along the others).
-  Vector3 wrap(const Vector3& position) const;
   // [owner of]
   /// The rank that owns a position: along each axis the cell whose [b_i, b_{i+1}) holds the
   /// wrapped position (a position on a boundary belongs to the cell above it; outside the domain,
   /// to the first or last cell). Exercise 8.1.
-  int owner_of(const Vector3& position) const;
+  int owner_of(const Vector3& position) const override;
   // [owner of]
 
-  /// The ranks whose subdomain, or a periodic image of it, lies within `reach` of the subdomain of
-  /// `rank` (distance between the boxes ≤ reach), sorted, each once; `rank` itself only through a
-  /// periodic image (an axis with one or two subdomains). The processes that must exchange
-  /// ghosts with `rank` when bodies interact up to `reach`.
-  std::vector<int> neighbours(int rank, double reach) const;
-
  private:
-  Box domain_;
   std::array<int, 3> dims_;
-  std::array<bool, 3> periodic_;
   std::array<std::vector<double>, 3> boundaries_;
-  std::vector<std::array<int, 3>> shifts_;
-  void make_shifts();
 };
 
 // [overlaps]

@@ -25,7 +25,7 @@ std::uint32_t image_code(const std::array<int, 3>& shift);
 /// that is not one.
 std::array<int, 3> image_shift(std::uint32_t code);
 
-/// The exchanges of bodies between the processes of a CartesianGrid. Every process of the
+/// The exchanges of bodies between the processes of a Partition. Every process of the
 /// communicator calls each operation at the same point (they are collective).
 ///
 /// A body of bounding radius r needs a ghost on every process whose subdomain (or a periodic image
@@ -39,7 +39,7 @@ class BodyExchange {
   /// radius r_max a body of the run can have [m] (from the scene), > 0: the neighbours are the
   /// subdomains within 2 r_max + margin. Throws InvalidArgument for a grid whose size is not the
   /// communicator's.
-  BodyExchange(const Communicator& comm, const CartesianGrid& grid, double margin,
+  BodyExchange(const Communicator& comm, const Partition& partition, double margin,
                double max_radius);
 
   /// Migration: clears the ghosts, wraps the owned bodies' centres along the periodic axes, and
@@ -78,7 +78,7 @@ class BodyExchange {
   /// InvalidArgument otherwise: bodies were added, removed or reordered since).
   void forward(timestep::BodySystem& system);
 
-  /// The processes this one exchanges with (CartesianGrid::neighbours for max_radius + margin).
+  /// The processes this one exchanges with (Partition::neighbours within 2 max_radius + margin).
   const std::vector<int>& neighbours() const { return neighbours_; }
 
  private:
@@ -86,7 +86,7 @@ class BodyExchange {
     std::vector<std::size_t> rows;  // owned rows, in message order
   };
   const Communicator& comm_;
-  const CartesianGrid& grid_;
+  const Partition& partition_;
   double margin_;
   double max_radius_;
   std::vector<int> neighbours_;

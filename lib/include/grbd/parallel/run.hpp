@@ -2,13 +2,14 @@
 /// \file
 /// \brief `mpirun -np P grbd run scene.toml` (chapter 8): a scene's run on the processes of a
 /// communicator — the same generators, output, checkpoints and restart as chapter 7's serial run,
-/// the bodies shared by a Cartesian grid of subdomains and stepped by the ParallelStepper.
+/// the bodies shared by a partition of the domain (a Cartesian grid or a bisection tree) and
+/// stepped by the ParallelStepper.
 
 #include <memory>
 
 #include "grbd/core/communicator.hpp"
 #include "grbd/io/run.hpp"
-#include "grbd/parallel/decomposition.hpp"
+#include "grbd/parallel/partition.hpp"
 #include "grbd/parallel/stepper.hpp"
 #include "grbd/scene/simulation.hpp"
 
@@ -20,8 +21,10 @@ namespace grbd::parallel {
 /// Bodies outside it belong to the nearest subdomain.
 Box decomposition_box(const scene::Scene& scene);
 
-/// A scene shared by the processes of a communicator: a CartesianGrid over decomposition_box()
-/// with grid_dims() subdomains, each process owning the bodies whose centre lies in its own, and
+/// A scene shared by the processes of a communicator: a partition of decomposition_box() into one
+/// subdomain per process — by the scene's `[parallel] partition`, a CartesianGrid with grid_dims()
+/// subdomains or the even BisectionTree — each process owning the bodies whose centre lies in
+/// its own, and
 /// a ParallelStepper for each, with the averaging and balance of the scene's `[parallel]` table
 /// (by default: average every sweep, look at the balance every 50 steps and rebalance when a
 /// process carries more than 1.1 times the mean load). Its step settings are the scene's,
@@ -29,26 +32,28 @@ Box decomposition_box(const scene::Scene& scene);
 /// candidate pairs are rebuilt when a body has moved a quarter of the smallest radius).
 class SceneDecomposition final : public scene::Distribution {
  public:
-  /// The grid for `comm.size()` processes over decomposition_box(scene); throws InvalidArgument
-  /// when that box is empty or not finite.
+  /// The partition for `comm.size()` processes over decomposition_box(scene); throws
+  /// InvalidArgument when that box is empty or not finite.
   SceneDecomposition(const Communicator& comm, const scene::Scene& scene);
   /// The processes of the run.
   const Communicator& communicator() const override { return comm_; }
-  /// Whether the grid gives a body centred at `centre` to this process (the engine's grid once
-  /// there is one: it may have been rebalanced since).
+  /// Whether the partition gives a body centred at `centre` to this process (the engine's
+  /// partition once there is one: it may have been rebalanced since).
   bool owns(const Vector3& centre) const override { return owner(centre) == comm_.rank(); }
-  /// The process that owns a body with this centre (the engine's grid once there is an engine).
+  /// The process that owns a body with this centre (the engine's partition once there is one).
   int owner(const Vector3& centre) const {
-    return (engine_ != nullptr ? engine_->grid() : grid_).owner_of(centre);
+    return (engine_ != nullptr ? engine_->partition() : *partition_).owner_of(centre);
   }
-  /// A ParallelStepper over the grid (the scene's settings, with a skin of half the tolerance
+  /// A ParallelStepper over the partition (the scene's settings, with a skin of half the tolerance
   /// radius when they give none).
   std::unique_ptr<scene::StepEngine> engine(timestep::BodySystem& system,
                                             const timestep::StaticGeometry& statics,
                                             const timestep::MaterialTable& materials,
                                             const timestep::StepSettings& settings) const override;
-  /// The grid of subdomains.
-  const CartesianGrid& grid() const { return grid_; }
+  /// How often the last engine made rebalanced its partition (0 before there is one).
+  std::uint64_t rebalances() const { return engine_ != nullptr ? engine_->rebalances() : 0; }
+  /// The partition the run starts from.
+  const Partition& partition() const { return *partition_; }
   /// The parallel step's settings (largest bounding radius of the scene's groups).
   const ParallelSettings& settings() const { return parallel_; }
 
@@ -56,7 +61,7 @@ class SceneDecomposition final : public scene::Distribution {
   // decomposition_box() once: it tessellates the static geometry when the scene has no outlet.
   SceneDecomposition(const Communicator& comm, const scene::Scene& scene, const Box& box);
   const Communicator& comm_;
-  CartesianGrid grid_;
+  std::unique_ptr<Partition> partition_;
   ParallelSettings parallel_;
   mutable const ParallelStepper* engine_ = nullptr;  // the last engine made
 };

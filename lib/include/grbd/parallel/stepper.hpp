@@ -32,8 +32,9 @@ struct ParallelSettings {
   int average_every = 1;
   /// Look at the balance of the processes' work every this many steps (0: never), at the first
   /// rebuild of the ghosts after it; when the most loaded process has more than `imbalance` times
-  /// the mean weight (a body weighs 1 plus its contacts of the last step), the grid is replaced by
-  /// the balanced_grid() of the bodies and every body moves to its new owner.
+  /// the mean weight (a body weighs 1 plus its contacts of the last step), the partition is
+  /// replaced by its Partition::rebalanced() for the bodies (a balanced_grid(), or a
+  /// BisectionTree::balanced() tree) and every body moves to its new owner.
   int rebalance_every = 0;
   double imbalance = 1.1;  ///< the largest load over the mean that needs no rebalancing, ≥ 1
 };
@@ -58,10 +59,12 @@ class ParallelStepper final : public scene::StepEngine {
  public:
   /// Throws InvalidArgument when settings.tolerance_radius is 0 (the active set of a parallel run
   /// must not depend on the bodies a process holds: take it from the scene), when max_radius is not
-  /// positive, or when the grid does not fit the communicator.
-  ParallelStepper(const Communicator& comm, const CartesianGrid& grid, timestep::BodySystem& system,
-                  const timestep::StaticGeometry& statics, const timestep::MaterialTable& materials,
-                  timestep::StepSettings settings, ParallelSettings parallel);
+  /// positive, or when the partition does not fit the communicator. The stepper keeps its own copy
+  /// of the partition.
+  ParallelStepper(const Communicator& comm, const Partition& partition,
+                  timestep::BodySystem& system, const timestep::StaticGeometry& statics,
+                  const timestep::MaterialTable& materials, timestep::StepSettings settings,
+                  ParallelSettings parallel);
   ~ParallelStepper() override;
   ParallelStepper(const ParallelStepper&) = delete;
   ParallelStepper& operator=(const ParallelStepper&) = delete;
@@ -78,10 +81,10 @@ class ParallelStepper final : public scene::StepEngine {
   std::uint64_t rebuilds() const { return rebuilds_; }
   /// Wall time spent so far averaging the split bodies' velocities (with its exchanges) [s].
   double averaging_seconds() const { return averaging_seconds_; }
-  /// How often the grid was rebalanced.
+  /// How often the partition was rebalanced.
   std::uint64_t rebalances() const { return rebalances_; }
-  /// The grid of subdomains in use (the one given, or the last balanced one).
-  const CartesianGrid& grid() const { return grid_; }
+  /// The partition in use (the one given, or the last balanced one).
+  const Partition& partition() const { return *partition_; }
   /// Bodies owned here that were split in the last step (their copies elsewhere had contacts).
   std::size_t split_bodies() const { return split_owned_; }
 
@@ -105,8 +108,8 @@ class ParallelStepper final : public scene::StepEngine {
   double imbalance_;
   double margin_;      // of the ghosts: contact margin + skin [m]
   double max_radius_;  // the largest bounding radius of the run [m]
-  CartesianGrid grid_;
-  std::optional<BodyExchange> exchange_;
+  std::unique_ptr<Partition> partition_;
+  std::optional<BodyExchange> exchange_;  // over *partition_
   std::unique_ptr<timestep::MoreauStepper> stepper_;
   std::vector<Vector3> reference_;       // owned centres at the last rebuild
   std::vector<double> copies_;           // per row: the number of copies of its body (1: not split)

@@ -138,6 +138,10 @@ double smallest_bounding_radius(const BodyGroup& group);
 /// How a run on many processes shares the work (table `[parallel]`, chapter 8); a serial run
 /// ignores it.
 struct ParallelSpec {
+  /// How the domain is cut among the processes: a Cartesian grid (`"grid"`, the default) or a
+  /// recursive coordinate bisection (`"bisection"`), each rebalanced by the bodies' weight.
+  enum class Partition { grid, bisection };
+  Partition partition = Partition::grid;  ///< key `partition`
   int average_every = 1;     ///< average the split bodies' velocities every this many sweeps, ≥ 1
   int rebalance_every = 50;  ///< look at the balance every this many steps (0: never)
   double imbalance = 1.1;    ///< the largest load over the mean that needs no rebalancing, ≥ 1
