@@ -329,6 +329,31 @@ TEST(BodyExchange, ImageCodesRoundTrip) {
   EXPECT_THROW(image_code({2, 0, 0}), InvalidArgument);
 }
 
+// The image of one copy seen from another is the difference of their shifts: seen from the body
+// itself, a ghost's own code; seen from an image, the body's code is the opposite shift's.
+TEST(BodyExchange, RelativeImagesAreDifferencesOfShifts) {
+  std::size_t pairs = 0;
+  for (std::uint32_t a = 0; a <= 27; ++a) {
+    if (a == 14) continue;
+    EXPECT_EQ(timestep::relative_image(0, a), a);
+    EXPECT_EQ(timestep::relative_image(a, a), 0u);
+    const std::array<int, 3> sa = image_shift(a);
+    EXPECT_EQ(timestep::relative_image(a, 0), image_code({-sa[0], -sa[1], -sa[2]}));
+    for (std::uint32_t b = 0; b <= 27; ++b) {
+      if (b == 14) continue;
+      const std::array<int, 3> sb = image_shift(b);
+      const std::array<int, 3> d{sb[0] - sa[0], sb[1] - sa[1], sb[2] - sa[2]};
+      if (std::abs(d[0]) > 1 || std::abs(d[1]) > 1 || std::abs(d[2]) > 1) {
+        EXPECT_THROW(timestep::relative_image(a, b), InvalidArgument);  // two periods apart
+      } else {
+        EXPECT_EQ(image_shift(timestep::relative_image(a, b)), d);
+        ++pairs;
+      }
+    }
+  }
+  EXPECT_EQ(pairs, 343u);  // per axis 7 of the 9 pairs of shifts are at most one apart: 7³
+}
+
 // ---- The parallel step ----------------------------------------------------------------------
 
 timestep::BodyRecord sphere(std::uint64_t id, double r, const Vector3& c, const Vector3& v) {

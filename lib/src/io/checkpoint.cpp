@@ -95,9 +95,8 @@ std::uint64_t sequential_checksum(const Checkpoint& c) {
   }
   for (std::size_t k = 0; k < s.warm_keys.size(); ++k) {
     const timestep::ContactKey& key = s.warm_keys[k];
-    for (std::uint64_t x :
-         {key.a, key.b, std::uint64_t{key.feature_a}, std::uint64_t{key.feature_b}})
-      sum.add(x);
+    for (std::uint64_t x : {key.a, key.b, key.feature_a, key.feature_b}) sum.add(x);
+    if (key.image != 0) sum.add(key.image);
     for (int d = 0; d < 3; ++d) sum.add(s.warm_lambda[k][d]);
   }
   for (const scene::GeneratorState& g : s.generators) {
@@ -106,6 +105,9 @@ std::uint64_t sequential_checksum(const Checkpoint& c) {
   }
   return sum.value();
 }
+
+// The columns of a warm start's key: a, b, feature_a, feature_b, image (version 4).
+constexpr std::size_t kKeyColumns = 5;
 
 // A warm start as the checkpoint holds it.
 struct WarmRow {
@@ -152,6 +154,7 @@ std::uint64_t warm_checksum(std::uint64_t row, const WarmRow& warm) {
   for (std::uint64_t x : {warm.key.a, warm.key.b, warm.key.feature_a, warm.key.feature_b}) {
     sum.add(x);
   }
+  if (warm.key.image != 0) sum.add(warm.key.image);  // version 4 (a version 3 key has none)
   for (double x : warm.lambda) sum.add(x);
   return sum.value();
 }
@@ -235,17 +238,20 @@ void write_temporary(const Communicator& comm, const std::filesystem::path& temp
                  body_block.offset, n, states.data(), x, file);
 
   const std::size_t m = warm.size();
-  std::vector<std::uint64_t> keys(4 * m);
+  std::vector<std::uint64_t> keys(kKeyColumns * m);
   std::vector<double> lambda(3 * m);
   for (std::size_t k = 0; k < m; ++k) {
-    keys[4 * k] = warm[k].key.a;
-    keys[4 * k + 1] = warm[k].key.b;
-    keys[4 * k + 2] = warm[k].key.feature_a;
-    keys[4 * k + 3] = warm[k].key.feature_b;
+    const timestep::ContactKey& key = warm[k].key;
+    std::uint64_t* row = keys.data() + kKeyColumns * k;
+    row[0] = key.a;
+    row[1] = key.b;
+    row[2] = key.feature_a;
+    row[3] = key.feature_b;
+    row[4] = key.image;
     for (int d = 0; d < 3; ++d) lambda[3 * k + d] = warm[k].lambda[d];
   }
-  h5::write_rows(root, "warm_start_keys", H5T_STD_U64LE, H5T_NATIVE_UINT64, warm_block.total, 4,
-                 warm_block.offset, m, keys.data(), x, file);
+  h5::write_rows(root, "warm_start_keys", H5T_STD_U64LE, H5T_NATIVE_UINT64, warm_block.total,
+                 kKeyColumns, warm_block.offset, m, keys.data(), x, file);
   h5::write_rows(root, "warm_start_lambda", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, warm_block.total, 3,
                  warm_block.offset, m, lambda.data(), x, file);
 
@@ -408,7 +414,9 @@ void read_part(const Communicator& comm, const std::filesystem::path& path, Part
   // This process's rows: a slab, or every row for the sequential checksum of versions 1 and 2.
   Handle body_type = h5::body_row_type();
   const std::uint64_t n = h5::rows_of(root, "bodies", body_type.get(), 0, file);
-  const std::uint64_t m = h5::rows_of(root, "warm_start_keys", H5T_NATIVE_UINT64, 4, file);
+  // A key's columns: a, b, feature_a, feature_b, and (version 4) the periodic image.
+  const std::size_t columns = version >= 4 ? kKeyColumns : 4;
+  const std::uint64_t m = h5::rows_of(root, "warm_start_keys", H5T_NATIVE_UINT64, columns, file);
   part.bodies = n;
   part.warm = m;
   const bool sliced = version >= 3;
@@ -443,8 +451,8 @@ void read_part(const Communicator& comm, const std::filesystem::path& path, Part
     }
   }
   std::vector<std::uint64_t> keys;
-  h5::read_rows(root, "warm_start_keys", H5T_NATIVE_UINT64, m, 4, warm_lo, warm_hi - warm_lo, keys,
-                file);
+  h5::read_rows(root, "warm_start_keys", H5T_NATIVE_UINT64, m, columns, warm_lo, warm_hi - warm_lo,
+                keys, file);
   std::vector<double> lambda;
   h5::read_rows(root, "warm_start_lambda", H5T_NATIVE_DOUBLE, m, 3, warm_lo, warm_hi - warm_lo,
                 lambda, file);
@@ -452,8 +460,14 @@ void read_part(const Communicator& comm, const std::filesystem::path& path, Part
   s.warm_keys.resize(w);
   s.warm_lambda.resize(w);
   for (std::size_t k = 0; k < w; ++k) {
-    const WarmRow row{{keys[4 * k], keys[4 * k + 1], keys[4 * k + 2], keys[4 * k + 3]},
+    const std::uint64_t* key = keys.data() + columns * k;
+    const WarmRow row{{key[0], key[1], key[2], key[3], columns > 4 ? key[4] : 0},
                       {lambda[3 * k], lambda[3 * k + 1], lambda[3 * k + 2]}};
+    if (row.key.image > 27 || row.key.image == 14) {
+      h5::fail(file, "dataset warm_start_keys, row " + std::to_string(warm_lo + k) +
+                         ": expected a periodic image code 0 to 27 other than 14, found " +
+                         std::to_string(row.key.image));
+    }
     s.warm_keys[k] = row.key;
     s.warm_lambda[k] = Vector3(row.lambda[0], row.lambda[1], row.lambda[2]);
     if (!s.warm_lambda[k].allFinite()) {

@@ -157,7 +157,9 @@ void agree(const Communicator& comm, Work&& work) {
     failed = true;
     message = e.what();
   }
-  if (comm.all(!failed)) return;
+  // A process that failed inside a collective call of parallel HDF5 has left the others waiting
+  // in it: after kAgreementPatience it ends the run with its message rather than wait forever.
+  if (comm.agree(!failed, message, kAgreementPatience)) return;
   std::vector<std::vector<std::byte>> all;
   std::vector<std::byte> mine(failed ? message.size() + 1 : 0);
   if (failed) std::memcpy(mine.data(), message.data(), message.size());

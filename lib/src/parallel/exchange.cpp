@@ -39,26 +39,6 @@ timestep::BodyRecord body_at(const std::vector<std::byte>& in, std::size_t offse
 
 }  // namespace
 
-std::uint32_t image_code(const std::array<int, 3>& s) {
-  for (const int c : s) {
-    if (c < -1 || c > 1) {
-      throw InvalidArgument("image_code: expected shifts of −1, 0 or 1 period, found " +
-                            std::to_string(c));
-    }
-  }
-  if (s[0] == 0 && s[1] == 0 && s[2] == 0) return 0;
-  return static_cast<std::uint32_t>(1 + (s[0] + 1) + 3 * (s[1] + 1) + 9 * (s[2] + 1));
-}
-
-std::array<int, 3> image_shift(std::uint32_t code) {
-  if (code == 0) return {0, 0, 0};
-  if (code > 27 || code == 14) {
-    throw InvalidArgument("image_shift: " + std::to_string(code) + " is not an image code");
-  }
-  const int k = static_cast<int>(code) - 1;
-  return {k % 3 - 1, (k / 3) % 3 - 1, k / 9 - 1};
-}
-
 BodyExchange::BodyExchange(const Communicator& comm, const Partition& partition, double margin,
                            double max_radius)
     : comm_(comm), partition_(partition), margin_(margin), max_radius_(max_radius) {

@@ -9,11 +9,14 @@
 #include <mpi.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <limits>
 #include <string>
+#include <thread>
 
+#include "grbd/core/checks.hpp"
 #include "grbd/core/error.hpp"
 
 namespace grbd::parallel {
@@ -114,6 +117,34 @@ bool MpiCommunicator::all(bool value) const {
         "MPI_Allreduce (all)");
   return flag != 0;
 }
+
+// [agree]
+bool MpiCommunicator::agree(bool ok, const std::string& error, double patience) const {
+  ++traffic_.collectives;
+  int flag = ok ? 1 : 0;
+  int result = 0;
+  MPI_Request request = MPI_REQUEST_NULL;
+  check(MPI_Iallreduce(&flag, &result, 1, MPI_INT, MPI_LAND, impl_->comm, &request),
+        "MPI_Iallreduce (agree)");
+  if (ok) {
+    check(MPI_Wait(&request, MPI_STATUS_IGNORE), "MPI_Wait (agree)");
+    return result != 0;
+  }
+  // This process failed: the others may be waiting inside a collective call it left.
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(patience);
+  int done = 0;
+  while (true) {
+    check(MPI_Test(&request, &done, MPI_STATUS_IGNORE), "MPI_Test (agree)");
+    if (done != 0) return result != 0;
+    if (std::chrono::steady_clock::now() > deadline) {
+      abort_run(error + " (the other processes did not answer within " + format_number(patience) +
+                    " s: they wait inside an operation this process could not finish)",
+                1);
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+}
+// [agree]
 
 void MpiCommunicator::broadcast(std::vector<std::byte>& bytes, int root) const {
   ++traffic_.collectives;

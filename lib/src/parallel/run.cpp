@@ -80,7 +80,10 @@ void agreed(const Communicator& comm, Work&& work) {
   } catch (const std::exception& e) {
     report(ErrorKind::other, e.what());
   }
-  if (comm.all(mine.empty())) return;
+  const std::string error =
+      mine.empty() ? std::string()
+                   : std::string(reinterpret_cast<const char*>(mine.data()) + 1, mine.size() - 1);
+  if (comm.agree(mine.empty(), error, kAgreementPatience)) return;
   std::vector<std::vector<std::byte>> all;
   comm.all_gather(mine, all);
   // An error every process met alike (a file they read together) needs no rank in its message.
@@ -213,19 +216,19 @@ SceneDecomposition::SceneDecomposition(const Communicator& comm, const scene::Sc
       partition_(make_partition(comm.size(), scene, box)),
       parallel_{largest_radius(scene), scene.parallel.average_every, scene.parallel.rebalance_every,
                 scene.parallel.imbalance} {
-  // A pair of bodies must not touch both directly and through a periodic boundary: the contact
-  // keys do not tell the two contacts apart.
+  // Along a periodic axis the images one period away must hold every contact (a body within reach
+  // of another through two periods would need more), and no body may reach its own image.
   const timestep::StepSettings& s = scene.settings;
   const double reach =
       2.0 * parallel_.max_radius + s.contact_tolerance * s.tolerance_radius + skin_of(s);
   const char* axes = "xyz";
   for (int d = 0; d < 3; ++d) {
     const double period = scene.domain.box.max[d] - scene.domain.box.min[d];
-    if (scene.domain.periodic[static_cast<std::size_t>(d)] && !(period > 2.0 * reach)) {
+    if (scene.domain.periodic[static_cast<std::size_t>(d)] && !(period > reach)) {
       throw scene::SceneError(scene.file.string() + ": [simulation] periodic: the domain is " +
                               format_number(period) + " m along " + axes[d] +
-                              ", expected more than twice the reach of a contact, " +
-                              format_number(2.0 * reach) + " m (two largest bodies and margins)");
+                              ", expected more than the reach of a contact, " +
+                              format_number(reach) + " m (two largest radii, margin and skin)");
     }
   }
 }

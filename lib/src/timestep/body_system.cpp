@@ -30,7 +30,8 @@ void permute_in_place(std::vector<T>& v, std::span<const std::int32_t> order,
     if (done[i]) continue;
     std::size_t j = i;
     done[j] = 1;
-    for (auto k = static_cast<std::size_t>(order[j]); k != i; k = static_cast<std::size_t>(order[j])) {
+    for (auto k = static_cast<std::size_t>(order[j]); k != i;
+         k = static_cast<std::size_t>(order[j])) {
       using std::swap;
       swap(v[j], v[k]);
       j = k;
@@ -82,8 +83,10 @@ void BodySystem::validate(const BodyRecord& spec, const char* what, std::uint32_
   const collision::ShapeKind kind = collision::kind(spec.shape);
   if (kind != collision::ShapeKind::sphere && kind != collision::ShapeKind::box &&
       kind != collision::ShapeKind::capsule) {
-    throw InvalidArgument(where() + ": expected a sphere, a box or a capsule as the shape of a "
-                          "body, found a " + std::string(collision::kind_name(kind)) +
+    throw InvalidArgument(where() +
+                          ": expected a sphere, a box or a capsule as the shape of a "
+                          "body, found a " +
+                          std::string(collision::kind_name(kind)) +
                           " (half-spaces and meshes are static objects)");
   }
   try {
@@ -106,7 +109,7 @@ void BodySystem::set_row(std::size_t i, const BodyRecord& spec, const Vector3& s
   if (!spec.dynamic()) states_[i].u.setZero();
   inertia_[i] = spec.inertia;
   M_inv_[i] = spec.dynamic() ? contact::inverse_mass(spec.inertia)
-                           : contact::InverseMass{0.0, Vector3::Zero()};
+                             : contact::InverseMass{0.0, Vector3::Zero()};
   bounding_radii_[i] = collision::bounding_radius(spec.shape);
   shapes_[i] = spec.shape;
   materials_[i] = spec.material;
@@ -153,8 +156,10 @@ BodyRecord BodySystem::record(std::size_t i) const {
 std::size_t BodySystem::add(const BodyRecord& spec) {
   validate(spec, "BodySystem::add", 0);
   if (ghost_count() > 0 && ghost_index_of(spec.id, 0) != npos) {
-    throw InvalidArgument("BodySystem::add (" + body_name(spec.id) + "): a ghost of it is present "
-                          "at local index " + std::to_string(ghost_index_of(spec.id, 0)) +
+    throw InvalidArgument("BodySystem::add (" + body_name(spec.id) +
+                          "): a ghost of it is present "
+                          "at local index " +
+                          std::to_string(ghost_index_of(spec.id, 0)) +
                           "; clear the ghosts before a body becomes owned here");
   }
   const std::size_t index = owned_count_;
@@ -187,8 +192,10 @@ std::size_t BodySystem::add_ghost(const BodyRecord& spec, const Vector3& shift,
                           "): expected a finite shift");
   }
   if (ghost_index_of(spec.id, image) != npos) {
-    throw InvalidArgument("BodySystem::add_ghost (" + body_name(spec.id) + "): its ghost with "
-                          "image " + std::to_string(image) + " is present already at local index " +
+    throw InvalidArgument("BodySystem::add_ghost (" + body_name(spec.id) +
+                          "): its ghost with "
+                          "image " +
+                          std::to_string(image) + " is present already at local index " +
                           std::to_string(ghost_index_of(spec.id, image)));
   }
   const std::size_t index = size();
@@ -321,11 +328,10 @@ void BodySystem::permute(std::span<const std::int32_t> order) {
   for (std::size_t i = 0; i < n; ++i) {
     const std::int32_t k = order[i];
     if (k < 0 || static_cast<std::size_t>(k) >= n || done_[static_cast<std::size_t>(k)]) {
-      throw InvalidArgument("BodySystem::permute: entry " + std::to_string(i) + " = " +
-                            std::to_string(k) +
-                            (k < 0 || static_cast<std::size_t>(k) >= n
-                                 ? " is out of range"
-                                 : " appears twice: expected a permutation"));
+      throw InvalidArgument(
+          "BodySystem::permute: entry " + std::to_string(i) + " = " + std::to_string(k) +
+          (k < 0 || static_cast<std::size_t>(k) >= n ? " is out of range"
+                                                     : " appears twice: expected a permutation"));
     }
     done_[static_cast<std::size_t>(k)] = 1;
   }
@@ -378,6 +384,31 @@ std::size_t StaticGeometry::add(StaticObject object) {
   ids_.insert(object.id);
   objects_.push_back(std::move(object));
   return objects_.size() - 1;
+}
+
+std::uint32_t image_code(const std::array<int, 3>& s) {
+  for (const int c : s) {
+    if (c < -1 || c > 1) {
+      throw InvalidArgument("image_code: expected shifts of −1, 0 or 1 period, found " +
+                            std::to_string(c));
+    }
+  }
+  if (s[0] == 0 && s[1] == 0 && s[2] == 0) return 0;
+  return static_cast<std::uint32_t>(1 + (s[0] + 1) + 3 * (s[1] + 1) + 9 * (s[2] + 1));
+}
+
+std::array<int, 3> image_shift(std::uint32_t code) {
+  if (code == 0) return {0, 0, 0};
+  if (code > 27 || code == 14) {
+    throw InvalidArgument("image_shift: " + std::to_string(code) + " is not an image code");
+  }
+  const int k = static_cast<int>(code) - 1;
+  return {k % 3 - 1, (k / 3) % 3 - 1, k / 9 - 1};
+}
+
+std::uint32_t relative_image(std::uint32_t a, std::uint32_t b) {
+  const std::array<int, 3> sa = image_shift(a), sb = image_shift(b);
+  return image_code({sb[0] - sa[0], sb[1] - sa[1], sb[2] - sa[2]});
 }
 
 }  // namespace grbd::timestep

@@ -91,12 +91,13 @@ std::uint64_t hash(const ContactKey& key) {
   std::uint64_t h = mix64(key.a);
   h = mix64(h ^ key.b);
   h = mix64(h ^ key.feature_a);
-  return mix64(h ^ key.feature_b);
+  h = mix64(h ^ key.feature_b);
+  return key.image == 0 ? h : mix64(h ^ key.image);
 }
 
 // [detect system]
-void ContactDetector::detect(const BodySystem& system, const StaticGeometry& statics,
-                             double margin, std::vector<DetectedContact>& contacts,
+void ContactDetector::detect(const BodySystem& system, const StaticGeometry& statics, double margin,
+                             std::vector<DetectedContact>& contacts,
                              std::vector<ContactKey>& keys) {
   if (!(margin >= 0.0 && std::isfinite(margin))) {
     throw InvalidArgument("ContactDetector::detect: expected a finite margin >= 0, found " +
@@ -111,10 +112,11 @@ void ContactDetector::detect(const BodySystem& system, const StaticGeometry& sta
   for (std::size_t i = 0; i < n; ++i) {
     const Vector7& q = states[i].q;
     if (!q.allFinite()) {
-      throw InvalidArgument("ContactDetector::detect: expected finite positions and orientations, "
-                            "found q = (" + format_number(q[0]) + ", " + format_number(q[1]) +
-                            ", " + format_number(q[2]) + ", …) for body " +
-                            std::to_string(ids[i]));
+      throw InvalidArgument(
+          "ContactDetector::detect: expected finite positions and orientations, "
+          "found q = (" +
+          format_number(q[0]) + ", " + format_number(q[1]) + ", " + format_number(q[2]) +
+          ", …) for body " + std::to_string(ids[i]));
     }
     placements_[i] = {kinematics::position(q),
                       kinematics::rotation_matrix(kinematics::orientation(q))};
@@ -132,6 +134,8 @@ void ContactDetector::detect(const BodySystem& system, const StaticGeometry& sta
   const auto id_of = [&](const Side& s) {
     return s.is_body ? ids[s.index] : (kStaticTag | objects[s.index].id);
   };
+  const auto images = system.images();
+  const auto image_of = [&](const Side& s) { return s.is_body ? images[s.index] : 0u; };
   // Side a: the first in the kind order sphere, box, capsule, half-space, mesh (the kernels'
   // argument order); between equal kinds, the smaller id. Neither depends on storage order.
   const auto pair = [&](Side x, Side y) {
@@ -154,7 +158,9 @@ void ContactDetector::detect(const BodySystem& system, const StaticGeometry& sta
       side(x, c.body_a, c.row_a, c.material_a);
       side(y, c.body_b, c.row_b, c.material_b);
       contacts.push_back(c);
-      keys.push_back({id_of(x), id_of(y), g.feature_a, g.feature_b});
+      const std::uint32_t ix = image_of(x), iy = image_of(y);
+      keys.push_back(
+          {id_of(x), id_of(y), g.feature_a, g.feature_b, ix == iy ? 0u : relative_image(ix, iy)});
     }
   };
 
@@ -213,8 +219,8 @@ void ContactDetector::detect(const BodySystem& system, const StaticGeometry& sta
   // spheres touch (a mesh has its own hierarchy, a half-space is unbounded).
   for (std::size_t s = 0; s < objects.size(); ++s) {
     const collision::ShapeKind kind = collision::kind(objects[s].shape);
-    const bool bounded = kind != collision::ShapeKind::half_space &&
-                         kind != collision::ShapeKind::mesh;
+    const bool bounded =
+        kind != collision::ShapeKind::half_space && kind != collision::ShapeKind::mesh;
     const double r_s = bounded ? collision::bounding_radius(objects[s].shape) : 0.0;
     const auto* half_space = std::get_if<collision::HalfSpace>(&objects[s].shape);
     for (std::size_t i = 0; i < n; ++i) {

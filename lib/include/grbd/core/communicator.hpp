@@ -9,9 +9,15 @@
 #include <cstddef>
 #include <cstdint>
 #include <span>
+#include <string>
 #include <vector>
 
 namespace grbd {
+
+/// How long a process that met an error waits for the others to agree on it [s]
+/// (Communicator::agree): long enough for any process that is not stuck to finish its part of a
+/// collective operation and arrive.
+inline constexpr double kAgreementPatience = 20.0;
 
 /// The processes of a run, numbered 0 … size() − 1, and their collective operations. Every
 /// process of the communicator must make the same collective calls in the same order, with
@@ -41,6 +47,18 @@ class Communicator {
   virtual bool all(bool value) const = 0;
   /// True on every process when `value` is true on some process.
   bool any(bool value) const { return !all(!value); }
+  /// The agreement after work that may have failed on some processes: true on every process when
+  /// `ok` is true on every process. A process whose `ok` is false waits at most `patience` seconds
+  /// for the others; when they do not all arrive — some wait inside a collective operation that
+  /// this process left through its error, of parallel HDF5 for instance — no agreement can come,
+  /// and this process ends the run with `error` (MpiCommunicator: abort_run(), exit code 1, one
+  /// message, every process ends) instead of waiting forever. A process whose `ok` is true waits
+  /// as long as it takes. The one-process communicator returns `ok`.
+  virtual bool agree(bool ok, const std::string& error, double patience) const {
+    static_cast<void>(error);
+    static_cast<void>(patience);
+    return all(ok);
+  }
 
   /// Rank `root`'s bytes, given to every process (resized there).
   virtual void broadcast(std::vector<std::byte>& bytes, int root) const = 0;

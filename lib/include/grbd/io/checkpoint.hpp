@@ -18,11 +18,12 @@ struct Checkpoint {
   std::string scene_text;        ///< the scene the run was started from
 };
 
-/// The format version written to checkpoints. Version 3's `checksum` is formed from the rows of
-/// bodies and warm starts independently, so that processes that each read or write a slab of
-/// rows form it together; version 2 (a checksum of every value in sequence) and version 1
-/// (without one) are still read.
-inline constexpr std::uint64_t kCheckpointFormatVersion = 3;
+/// The format version written to checkpoints. Version 4's warm-start keys have a fifth column, the
+/// periodic image of the contact (timestep::ContactKey::image). Version 3's `checksum` is formed
+/// from the rows of bodies and warm starts independently, so that processes that each read or
+/// write a slab of rows form it together; versions 3 (keys without an image), 2 (a checksum of
+/// every value in sequence) and 1 (without one) are still read.
+inline constexpr std::uint64_t kCheckpointFormatVersion = 4;
 
 /// Writes `checkpoint` to `path` atomically: into a temporary file beside it, flushed to the disk
 /// (fsync), then renamed over `path`, so that a crash at any moment leaves either the previous

@@ -18,12 +18,8 @@
 
 namespace grbd::parallel {
 
-/// The image code of a periodic shift s ∈ {−1, 0, 1}³ (in periods along each axis): 0 for no shift,
-/// else 1 + (s_x + 1) + 3 (s_y + 1) + 9 (s_z + 1). A ghost's (global id, image) is its identity.
-std::uint32_t image_code(const std::array<int, 3>& shift);
-/// The shift of an image code (the inverse of image_code()); throws InvalidArgument for a code
-/// that is not one.
-std::array<int, 3> image_shift(std::uint32_t code);
+using timestep::image_code;   // a periodic shift's code (timestep/body_system.hpp)
+using timestep::image_shift;  // the shift of a code
 
 /// The exchanges of bodies between the processes of a Partition. Every process of the
 /// communicator calls each operation at the same point (they are collective).

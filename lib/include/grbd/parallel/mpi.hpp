@@ -36,6 +36,9 @@ class MpiCommunicator final : public Communicator {
   void max(std::span<double> values) const override;
   void min(std::span<double> values) const override;
   bool all(bool value) const override;
+  /// A non-blocking reduction (MPI_Iallreduce) that a process with `ok` false tests until
+  /// `patience` has passed, then ends every process through abort_run(error, 1).
+  bool agree(bool ok, const std::string& error, double patience) const override;
   void broadcast(std::vector<std::byte>& bytes, int root) const override;
   void all_gather(std::span<const std::byte> mine,
                   std::vector<std::vector<std::byte>>& all) const override;

@@ -7,6 +7,7 @@
 /// kept apart, each object with its own stable id. Chapters 7 (scene files, restart) and 8 (MPI
 /// migration, ghosts) build on both.
 
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <span>
@@ -22,6 +23,18 @@
 #include "grbd/timestep/body_record.hpp"
 
 namespace grbd::timestep {
+
+/// The image code of a periodic shift s ∈ {−1, 0, 1}³ (in periods along each axis): 0 for no shift,
+/// else 1 + (s_x + 1) + 3 (s_y + 1) + 9 (s_z + 1). A ghost's (global id, image) is its identity
+/// (chapter 8). Throws InvalidArgument for a component outside {−1, 0, 1}.
+std::uint32_t image_code(const std::array<int, 3>& shift);
+/// The shift of an image code (the inverse of image_code()); throws InvalidArgument for a code
+/// that is not one.
+std::array<int, 3> image_shift(std::uint32_t code);
+/// The image of a copy with code `b` as seen from a copy with code `a`: the code of the shift
+/// s_b − s_a (0 when both are the same image). Throws InvalidArgument when that shift is not
+/// in {−1, 0, 1}³.
+std::uint32_t relative_image(std::uint32_t a, std::uint32_t b);
 
 /// The bodies of a simulation as parallel arrays ("structure of arrays"): entry i of every array
 /// belongs to the body with local index i. Local indices change when bodies are removed or
@@ -87,7 +100,7 @@ class BodySystem {
 
   /// \name The arrays, indexed by local body index
   ///@{
-  std::span<const GlobalId> ids() const { return ids_; }  ///< stable global ids
+  std::span<const GlobalId> ids() const { return ids_; }           ///< stable global ids
   std::span<const body::State> states() const { return states_; }  ///< q and u
   /// The states, writable: the time stepper advances them. The caller keeps them finite and
   /// |p| = 1 (the stepper checks what it computes).
@@ -98,7 +111,7 @@ class BodySystem {
   std::span<const contact::InverseMass> M_inv() const { return M_inv_; }
   std::span<const collision::Shape> shapes() const { return shapes_; }  ///< collision shapes
   std::span<const MaterialId> materials() const { return materials_; }  ///< material ids
-  std::span<const std::uint8_t> flags() const { return flags_; }  ///< BodyFlags bits
+  std::span<const std::uint8_t> flags() const { return flags_; }        ///< BodyFlags bits
   /// Radius of the bounding sphere of each body's shape about S [m].
   std::span<const double> bounding_radii() const { return bounding_radii_; }
   /// The image of each row: 0 for owned bodies and plain ghosts, the periodic image of a shifted
@@ -152,10 +165,10 @@ class BodySystem {
 
 /// One object fixed in the world: a half-space, a box, a capsule or a triangle mesh.
 struct StaticObject {
-  GlobalId id = 0;                 ///< stable identity among static objects, < kStaticTag
-  collision::Shape shape;          ///< the geometry (a sphere is allowed too)
-  collision::Placement pose;       ///< where its frame C sits in I (ignored by a half-space)
-  MaterialId material = 0;         ///< row of the material table
+  GlobalId id = 0;            ///< stable identity among static objects, < kStaticTag
+  collision::Shape shape;     ///< the geometry (a sphere is allowed too)
+  collision::Placement pose;  ///< where its frame C sits in I (ignored by a half-space)
+  MaterialId material = 0;    ///< row of the material table
 };
 
 /// The static geometry of a scene, apart from the bodies: static objects never move and never
@@ -163,8 +176,8 @@ struct StaticObject {
 class StaticGeometry {
  public:
   /// Appends an object and returns its index, in O(1) (the ids are hashed). Throws
-  /// InvalidArgument, naming the id, for an id used twice or ≥ kStaticTag, a non-finite pose, a rotation that is not one, or a bad shape.
-  /// A half-space is stored with a unit normal.
+  /// InvalidArgument, naming the id, for an id used twice or ≥ kStaticTag, a non-finite pose, a
+  /// rotation that is not one, or a bad shape. A half-space is stored with a unit normal.
   std::size_t add(StaticObject object);
   /// The objects in the order they were added.
   std::span<const StaticObject> objects() const { return objects_; }

@@ -18,16 +18,20 @@
 namespace grbd::timestep {
 
 /// The identity of a contact, independent of where the bodies are stored: the global ids of the
-/// two sides (a static object's id tagged with kStaticTag) and their features. Side a is the
-/// first in the order sphere, box, capsule, half-space, mesh and, between two sides of the same
-/// kind, the one with the smaller id; so reordering, removal, restart and (chapter 8) migration
-/// keep every key.
+/// two sides (a static object's id tagged with kStaticTag), their features, and the periodic
+/// image through which they touch. Side a is the first in the order sphere, box, capsule,
+/// half-space, mesh and, between two sides of the same kind, the one with the smaller id; so
+/// reordering, removal, restart and (chapter 8) migration keep every key, and two bodies that touch
+/// both directly and through a periodic boundary have two keys.
 struct ContactKey {
   std::uint64_t a = 0;          ///< global id of side a (kStaticTag | id for a static object)
   std::uint64_t b = 0;          ///< global id of side b
   std::uint64_t feature_a = 0;  ///< feature of a (collision::face_feature() and others)
   std::uint64_t feature_b = 0;  ///< feature of b
-  /// Lexicographic in (a, b, feature_a, feature_b).
+  /// The periodic image of side b as side a sees it: relative_image() of the two copies that
+  /// touch; 0 without periodic boundaries.
+  std::uint64_t image = 0;
+  /// Lexicographic in (a, b, feature_a, feature_b, image).
   friend auto operator<=>(const ContactKey&, const ContactKey&) = default;
 };
 
@@ -42,10 +46,10 @@ struct DetectedContact {
   collision::BodyIndex body_b = collision::kStatic;  ///< as body_a, for side b
   /// The row of side a in the BodySystem, fixed bodies included; −1 for a static object.
   std::int32_t row_a = -1;
-  std::int32_t row_b = -1;  ///< as row_a, for side b
-  MaterialId material_a = 0;                         ///< material of side a
-  MaterialId material_b = 0;                         ///< material of side b
-  collision::ContactGeometry geometry;               ///< n, g_N, points, features
+  std::int32_t row_b = -1;              ///< as row_a, for side b
+  MaterialId material_a = 0;            ///< material of side a
+  MaterialId material_b = 0;            ///< material of side b
+  collision::ContactGeometry geometry;  ///< n, g_N, points, features
 };
 
 /// Contact detection for a BodySystem and its StaticGeometry. Every buffer is a member and keeps
@@ -118,8 +122,8 @@ class WarmStartTable {
   /// InvalidArgument), zero for a new contact; returns how many keys were found.
   std::size_t initialize(std::span<const ContactKey> keys, std::span<Vector3> lambda) const;
   /// The stored keys and percussions (for checkpoints, chapter 7).
-  std::span<const ContactKey> keys() const { return keys_; }     ///< the stored keys
-  std::span<const Vector3> lambda() const { return lambda_; }     ///< their percussions
+  std::span<const ContactKey> keys() const { return keys_; }   ///< the stored keys
+  std::span<const Vector3> lambda() const { return lambda_; }  ///< their percussions
   /// Number of stored contacts.
   std::size_t size() const { return keys_.size(); }
   /// Forgets everything (keeps the capacity).
@@ -158,7 +162,7 @@ void keep_contacts_if(std::vector<DetectedContact>& contacts, std::vector<Contac
   keys.resize(kept);
 }
 
-/// A 64-bit hash of a key (splitmix64 finalisers of its four words).
+/// A 64-bit hash of a key (splitmix64 finalisers of its words; the image only when it is not 0).
 std::uint64_t hash(const ContactKey& key);
 
 }  // namespace grbd::timestep
