@@ -59,12 +59,13 @@ ParallelStepper::ParallelStepper(const Communicator& comm, const Partition& part
     if (k % average_every_ == 0 || k == max_iterations_) average_split_velocities(u);
   };
   hooks.solver.global_status = [this](contact::IterationStatus local) {
-    // Converged only after an averaged sweep, when the copies of every split body agree.
-    if (local == contact::IterationStatus::converged && any_split_ &&
-        sweep_ % average_every_ != 0) {
-      local = contact::IterationStatus::running;
+    // The verdict is taken after the averaged sweeps only, where the copies of every split body
+    // agree: one reduction every average_every sweeps (and at the last sweep the solver may do),
+    // the same sweeps on every process. In between every process goes on.
+    if (sweep_ % average_every_ != 0 && sweep_ != max_iterations_) {
+      return contact::IterationStatus::running;
     }
-    std::vector<double> status{static_cast<double>(local)};
+    double status[1] = {static_cast<double>(local)};
     comm_.max(status);
     return static_cast<contact::IterationStatus>(static_cast<int>(status[0]));
   };

@@ -51,7 +51,8 @@ struct ParallelSettings {
 ///   m copies (the owner's and the active ghosts) carries the mass M/m, and after every sweep the
 ///   copies' velocities are replaced by their mean, the velocity all copies share at the solution
 ///   (Tonge, Benevolenski, Voroshilov 2012);
-/// - the solver stops when every process has converged, and the report sums contacts and
+/// - the solver stops when every process has converged, a verdict taken together (one reduction)
+///   after each averaged sweep only, and the report sums contacts and
 ///   energies over the processes (in rank order) and takes the largest residual, penetration and
 ///   iteration count.
 /// With one process and no periodic axis there are no ghosts, and the step is the serial step.
