@@ -88,17 +88,18 @@ TEST(SceneFile, AMinimalSceneTakesTheDocumentedDefaults) {
 TEST(SceneFile, TheActiveSetToleranceScalesTheSmallestRadiusAnyGroupCanProduce) {
   // chapter 7's test chute: beads of radius uniform in [4, 6] mm from a lattice and an inflow,
   // removed at an outlet; the tolerance must not follow the smallest bead present.
-  const Scene chute = grbd::scene::load_scene(std::filesystem::path(GRBD_CH07_DATA_DIR) /
-                                              "chute.toml");
+  const Scene chute =
+      grbd::scene::load_scene(std::filesystem::path(GRBD_CH07_DATA_DIR) / "chute.toml");
   EXPECT_EQ(chute.settings.tolerance_radius, 0.004);
   // A box's bounding radius is |h|, a capsule's r + l; the smallest over the groups counts.
   std::string text = replace(kMinimal, "radius = 0.01", "radius = 2.0");
   EXPECT_EQ(parse_scene(text, "x.toml").settings.tolerance_radius, 2.0);
-  text += "[[bodies]]\nname = \"bricks\"\nshape = \"box\"\nhalf_extents = [0.3, 0.4, 1.2]\n"
-          "density = 1000.0\nmaterial = \"glass\"\npositions = [[5.0, 0.0, 2.0]]\n"
-          "[[bodies]]\nname = \"rods\"\nshape = \"capsule\"\nradius = 0.5\n"
-          "half_length = 0.9\ndensity = 1000.0\nmaterial = \"glass\"\n"
-          "positions = [[9.0, 0.0, 2.0]]\n";
+  text +=
+      "[[bodies]]\nname = \"bricks\"\nshape = \"box\"\nhalf_extents = [0.3, 0.4, 1.2]\n"
+      "density = 1000.0\nmaterial = \"glass\"\npositions = [[5.0, 0.0, 2.0]]\n"
+      "[[bodies]]\nname = \"rods\"\nshape = \"capsule\"\nradius = 0.5\n"
+      "half_length = 0.9\ndensity = 1000.0\nmaterial = \"glass\"\n"
+      "positions = [[9.0, 0.0, 2.0]]\n";
   EXPECT_DOUBLE_EQ(parse_scene(text, "x.toml").settings.tolerance_radius, 1.3);
   text = replace(text, "half_length = 0.9", "half_length = 0.7");  // now the capsule: 1.2
   EXPECT_DOUBLE_EQ(parse_scene(text, "x.toml").settings.tolerance_radius, 1.2);
@@ -146,11 +147,11 @@ TEST(SceneFile, AMisspeltKeyOfAnEitherOrPairIsNamedAtItsLine) {
                              "[bodies.generatr]\nkind = \"lattice\"")),
             "scene.toml:15:9: bodies[0].generatr: unknown key (did you mean \"generator\"?)");
   // Truly neither, or both: said as such.
-  EXPECT_NE(error_of(replace(kMinimal, "density = 2500\n", "")).find(
-                "expected exactly one of density [kg/m³] and mass [kg], found neither"),
+  EXPECT_NE(error_of(replace(kMinimal, "density = 2500\n", ""))
+                .find("expected exactly one of density [kg/m³] and mass [kg], found neither"),
             std::string::npos);
-  EXPECT_NE(error_of(replace(kMinimal, "density = 2500", "density = 2500\nmass = 1.0")).find(
-                "found both"),
+  EXPECT_NE(error_of(replace(kMinimal, "density = 2500", "density = 2500\nmass = 1.0"))
+                .find("found both"),
             std::string::npos);
 }
 
@@ -346,6 +347,41 @@ TEST(SceneFile, AHalfSpaceIsOrientedByItsNormalAlone) {
               std::string::npos)
         << e.what();
   }
+}
+
+// A gate (a static object with `until`) holds a sphere against gravity along −x until t = 0.05 s
+// and is then gone: the sphere rests at the gate, then falls freely, x = x₀ − g (t − 0.05)² / 2
+// (Moreau's midpoint step is exact for a constant acceleration).
+TEST(SceneFile, AGateHoldsTheBodiesUntilItsTimeAndIsThenGone) {
+  const std::string text =
+      replace(replace(kMinimal, "end_time = 0.01",
+                      "end_time = 0.1\n"
+                      "gravity = [-9.81, 0.0, 0.0]"),
+              "positions = [[0.0, 0.0, 0.1], [0.0, 0.0, 0.2]]", "positions = [[0.01, 0.0, 0.0]]") +
+      "\n[[static]]\nname = \"gate\"\nshape = \"half_space\"\n"
+      "normal = [1, 0, 0]\nmaterial = \"glass\"\nuntil = 0.05\n";
+  const Scene scene = parse_scene(text, "gate.toml");
+  ASSERT_EQ(scene.statics.size(), 1u);
+  EXPECT_EQ(scene.statics[0].until, 0.05);
+  grbd::scene::Simulation simulation(scene);
+  while (!simulation.finished()) {
+    const double t = simulation.stepper().time();
+    simulation.step();
+    const double x = simulation.system().states()[0].q.x();
+    if (t < 0.05 - 1e-9) {
+      EXPECT_NEAR(x, 0.01, 1e-9) << "held by the gate at t = " << t;
+      EXPECT_EQ(simulation.statics().size(), 1u);
+    } else {
+      const double fall = simulation.stepper().time() - 0.05;
+      EXPECT_NEAR(x, 0.01 - 0.5 * 9.81 * fall * fall, 1e-9) << "falling at t = " << t;
+      EXPECT_EQ(simulation.statics().size(), 0u);
+    }
+  }
+  EXPECT_LT(simulation.system().states()[0].q.x(), 0.0);  // past where the gate stood
+  const std::string bad = error_of(replace(text, "until = 0.05", "until = 0"));
+  EXPECT_NE(bad.find("static[0].until: expected a number > 0, found the integer 0"),
+            std::string::npos)
+      << bad;
 }
 
 // Costs that grow linearly: 10⁵ static objects (each id checked against the others by a hash,

@@ -594,6 +594,7 @@ void read_static(TableReader& t, Scene& scene, const std::filesystem::path& fold
   material_index(scene, t, "material", s.material);
   const Vector3 position = t.vector("position", Vector3::Zero());
   s.pose.I_r = position;
+  s.until = t.real_opt("until", kPositive);
   switch (kind) {
     case 0: {
       // A half-space has no orientation of its own: its normal says where it faces.

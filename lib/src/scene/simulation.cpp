@@ -264,7 +264,7 @@ std::pair<double, std::size_t> Simulation::static_gap(const collision::Shape& sh
     for (const collision::ContactGeometry& geometry : found) {
       if (geometry.g_N < gap) {
         gap = geometry.g_N;
-        which = s;
+        which = static_cast<std::size_t>(objects[s].id);  // the scene's index
       }
     }
   }
@@ -358,6 +358,7 @@ Simulation::Simulation(Scene scene, const SimulationState* state, const Distribu
 void Simulation::build_static() {
   for (std::size_t k = 0; k < scene_.statics.size(); ++k) {
     const StaticSpec& s = scene_.statics[k];
+    if (s.until) ++pending_removals_;
     timestep::StaticObject object;
     object.id = k;
     object.shape = s.shape;
@@ -757,7 +758,21 @@ void Simulation::outlet() {
   removed_mass_ += sums[1];
 }
 
+// [remove statics]
+// The static objects whose time is up (key until) are gone before the step that starts at
+// t ≥ until — the same step on every process and after a restart, since t is the stepper's clock.
+void Simulation::remove_expired_statics() {
+  if (pending_removals_ == 0) return;
+  const double t = stepper_->time();
+  for (std::size_t k = 0; k < scene_.statics.size(); ++k) {
+    const std::optional<double>& until = scene_.statics[k].until;
+    if (until && t >= *until && statics_.remove(k)) --pending_removals_;
+  }
+}
+// [remove statics]
+
 timestep::StepReport Simulation::step() {
+  remove_expired_statics();
   const std::uint64_t before = system_.owned_count();
   inflow();
   if (system_.owned_count() != before) engine_->bodies_changed();

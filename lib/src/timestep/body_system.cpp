@@ -386,6 +386,12 @@ std::size_t StaticGeometry::add(StaticObject object) {
   return objects_.size() - 1;
 }
 
+bool StaticGeometry::remove(std::uint64_t id) {
+  if (ids_.erase(id) == 0) return false;
+  std::erase_if(objects_, [id](const StaticObject& object) { return object.id == id; });
+  return true;
+}
+
 std::uint32_t image_code(const std::array<int, 3>& s) {
   for (const int c : s) {
     if (c < -1 || c > 1) {

@@ -91,6 +91,9 @@ struct StaticSpec {
   collision::Placement pose;        ///< where its frame sits in I
   std::string material;             ///< the name of a material
   std::filesystem::path mesh_file;  ///< mesh: the OBJ file, resolved against the scene's folder
+  /// The time from which the object is gone [s] (key `until`): a gate that holds the bodies while
+  /// they settle and is then taken away. The step that starts at t ≥ until no longer sees it.
+  std::optional<double> until;
 };
 
 /// The contact law of a pair of materials.

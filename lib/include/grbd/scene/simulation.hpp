@@ -146,6 +146,7 @@ class Simulation {
   void add_body(timestep::BodyRecord record, const body::State& state);
   void inflow();
   void outlet();
+  void remove_expired_statics();
   void gather_near(std::vector<Vector4>& near);
   void check_shapes() const;
   timestep::BodyRecord make_body(std::size_t group, Random& random);
@@ -173,6 +174,7 @@ class Simulation {
   std::uint64_t backlog_ = 0;
   std::vector<std::size_t> leaving_;
   std::vector<Vector3> image_shifts_;  // of a body's periodic images, the body itself first
+  std::size_t pending_removals_ = 0;   // static objects with an `until` still present
   std::unique_ptr<Scratch> scratch_;
 };
 

@@ -179,6 +179,9 @@ class StaticGeometry {
   /// InvalidArgument, naming the id, for an id used twice or ≥ kStaticTag, a non-finite pose, a
   /// rotation that is not one, or a bad shape. A half-space is stored with a unit normal.
   std::size_t add(StaticObject object);
+  /// Removes the object with this id (the others keep their order), in O(objects); false when
+  /// there is none. Contacts with it are no longer found from the next detection on.
+  bool remove(std::uint64_t id);
   /// The objects in the order they were added.
   std::span<const StaticObject> objects() const { return objects_; }
   /// Number of objects.
