@@ -49,6 +49,7 @@
 #include "grbd/contact/fclib_bench.hpp"
 #include "grbd/io/output.hpp"
 #include "grbd/io/run.hpp"
+#include "grbd/parallel/chute.hpp"
 #include "grbd/parallel/mpi.hpp"
 #include "grbd/parallel/run.hpp"
 #include "grbd/scene/scene.hpp"
@@ -79,6 +80,9 @@ constexpr const char* kValidateExitCodes =
     "(the message names file, line and key); 1 out of memory.";
 constexpr const char* kInfoExitCodes =
     "Exit codes: 0 done; 2 bad command line; 3 not a readable grbd output file.";
+constexpr const char* kChuteExitCodes =
+    "Exit codes: 0 done; 1 the CSV could not be written; 2 bad command line; 3 not a readable "
+    "grbd output file.";
 constexpr const char* kFclibExitCodes =
     "Exit codes: 0 every problem was solved (converged or not: the table says); 1 the CSV could "
     "not be written; 2 bad command line (also a CSV that is one of the problems); 3 a file the "
@@ -329,6 +333,86 @@ int info_command(const std::string& file) {
   }
 }
 
+// [chute command]
+// The chute study's measurements from an output (chapter 8): per record the flow count F — the
+// beads past the kink, those the outlet removed counted as past — and the front; then the times
+// of the reference study.
+int chute_command(const std::string& file, const std::optional<std::string>& csv, double kink_x,
+                  double entry_count) {
+  namespace par = grbd::parallel;
+  const par::ChuteGeometry chute{kink_x, 10.0};
+  std::vector<double> t, count, fronts, bodies;
+  try {
+    const grbd::io::OutputSummary summary = grbd::io::read_summary(file);
+    if (summary.records == 0) throw grbd::io::IoError(file + ": holds no record");
+    std::vector<grbd::Vector3> centres;
+    double beads = 0.0;
+    for (std::uint64_t k = 0; k < summary.records; ++k) {
+      const grbd::io::Record record = grbd::io::read_record(file, k);
+      centres.clear();
+      for (const grbd::body::State& x : record.states) centres.push_back(x.q.head<3>());
+      if (k == 0) beads = static_cast<double>(centres.size());
+      const double removed = std::max(0.0, beads - static_cast<double>(centres.size()));
+      t.push_back(record.t);
+      count.push_back(static_cast<double>(par::flow_count(centres, chute)) + removed);
+      fronts.push_back(par::front(centres, chute));
+      bodies.push_back(static_cast<double>(centres.size()));
+    }
+    if (!(beads > 0.0)) throw grbd::io::IoError(file + ": the first record holds no bead");
+    const par::FlowTimes times = par::flow_times(t, count, beads, entry_count);
+    if (csv) {
+      // Written under a temporary name and renamed once complete: an earlier CSV stays whole.
+      const std::filesystem::path temporary = *csv + ".tmp";
+      {
+        std::ofstream out(temporary);
+        out << "t_s,bodies,flow_count,front_m\n" << std::setprecision(9);
+        for (std::size_t k = 0; k < t.size(); ++k) {
+          out << t[k] << ',' << bodies[k] << ',' << count[k] << ',' << fronts[k] << '\n';
+        }
+        if (!out.flush()) {
+          std::error_code error;
+          std::filesystem::remove(temporary, error);
+          throw grbd::io::IoError(temporary.string() + ": cannot be written");
+        }
+      }
+      std::error_code error;
+      std::filesystem::rename(temporary, *csv, error);
+      if (error) {
+        std::filesystem::remove(temporary, error);
+        throw grbd::io::IoError(*csv + ": cannot be written (" + error.message() + ")");
+      }
+    }
+    const auto fixed = [](double x) {
+      std::ostringstream out;
+      out << std::setprecision(4) << x;
+      return out.str();
+    };
+    const auto when = [&](const std::optional<double>& x) {
+      return x ? fixed(*x) + " s" : std::string("never");
+    };
+    std::cout << "chute " << file << ": " << beads << " beads, " << t.size()
+              << " records, t = " << t.front() << " … " << t.back() << " s, kink at x = " << kink_x
+              << " m\n"
+              << "  entry (" << entry_count << " beads past the kink): " << when(times.entry)
+              << "\n  1 % past: " << when(times.first) << ", 95 % past: " << when(times.last)
+              << "\n  flow duration (1 % to 95 %): " << when(times.duration());
+    if (times.entry && times.last) {
+      std::cout << ", from the entry to 95 %: " << fixed(*times.last - *times.entry) << " s";
+    }
+    std::cout << "\n  beads past the kink at the end: " << count.back() << " ("
+              << fixed(100.0 * count.back() / beads) << " %), front " << fixed(fronts.back())
+              << " m along the floors\n";
+    return 0;
+  } catch (const grbd::io::IoError& e) {
+    std::cerr << "grbd chute: " << e.what() << '\n';
+    return csv && std::string(e.what()).find(*csv) != std::string::npos ? kExitFailed : kExitInput;
+  } catch (const grbd::Error& e) {
+    std::cerr << "grbd chute: " << file << ": " << e.what() << '\n';
+    return kExitInput;
+  }
+}
+// [chute command]
+
 int fclib_command(const std::vector<std::string>& inputs, double tol, int max_iterations,
                   const std::optional<std::string>& csv) {
   std::vector<std::filesystem::path> files;
@@ -529,6 +613,34 @@ int grbd_main(int argc, char** argv) {
       ->check(CLI::ExistingFile);
   info->footer(kInfoExitCodes);
 
+  std::string chute_file;
+  std::optional<std::string> chute_csv;
+  double chute_kink = -0.296;
+  double chute_entry = 150.0;
+  CLI::App* chute = app.add_subcommand(
+      "chute",
+      "Measure a chute run (chapter 8): the flow count past the kink, the front, the "
+      "entry time and the flow duration");
+  chute->add_option("output", chute_file, "The HDF5 output of grbd run")
+      ->required()
+      ->check(CLI::ExistingFile);
+  chute->add_option("--csv", chute_csv, "Also write t, bodies, flow count and front per record");
+  // CLI::Range lets NaN through (every comparison with it is false): a finite number first.
+  const CLI::Validator finite(
+      [](std::string& text) {
+        char* end = nullptr;
+        const double x = std::strtod(text.c_str(), &end);
+        return end != text.c_str() && *end == '\0' && std::isfinite(x)
+                   ? std::string()
+                   : "expected a finite number, found " + text;
+      },
+      "FINITE");
+  chute->add_option("--kink", chute_kink, "x of the kink [m], default -0.296 (the reference)")
+      ->check(finite & CLI::Range(-1e3, 1e3));
+  chute->add_option("--entry", chute_entry, "beads past the kink that mark the entry, default 150")
+      ->check(finite & CLI::PositiveNumber);
+  chute->footer(kChuteExitCodes);
+
   std::vector<std::string> fclib_inputs;
   double fclib_tol = 1e-8;
   int fclib_max_iterations = 20000;
@@ -598,6 +710,7 @@ int grbd_main(int argc, char** argv) {
                          progress);
     if (validate->parsed()) return validate_command(validate_file);
     if (info->parsed()) return info_command(info_file);
+    if (chute->parsed()) return chute_command(chute_file, chute_csv, chute_kink, chute_entry);
     if (fclib->parsed())
       return fclib_command(fclib_inputs, fclib_tol, fclib_max_iterations, fclib_csv);
     if (bench->parsed()) return bench_command(bench_names, bench_list, bench->remaining());

@@ -1,0 +1,56 @@
+#pragma once
+/// \file
+/// \brief The chute study (chapter 8): the reference chute's geometry as its measurements need it,
+/// the flow count past the kink, the front, and the times the flow takes.
+
+#include <cstddef>
+#include <optional>
+#include <span>
+#include <vector>
+
+#include "grbd/core/types.hpp"
+
+namespace grbd::parallel {
+
+/// The reference chute (Nützi's experiment as GRSFramework's study set it up): an upper chute
+/// whose floor is the plane z = 0, the beads flowing towards −x, and from x = kink_x on a run-out
+/// `bend_degrees` flatter, its floor rising above z = 0 downstream of the kink.
+struct ChuteGeometry {
+  double kink_x = -0.296;      ///< where the run-out begins [m]
+  double bend_degrees = 10.0;  ///< the run-out's angle to the upper floor [°]
+
+  /// A position in the run-out's frame: origin at the kink, x' along the run-out's floor (negative
+  /// downstream, as the reference gives the trees), y' = y, z' the height above that floor.
+  Vector3 runout(const Vector3& position) const;
+  /// The distance along the floors from the top of the upper chute (x = 0) downstream to below a
+  /// position [m]: −x on the upper chute, −kink_x − x' on the run-out.
+  double path(const Vector3& position) const;
+};
+
+// [flow count]
+/// The flow count F: the number of beads whose centre is past the kink (x < kink_x). Exercise 8.4.
+std::size_t flow_count(std::span<const Vector3> centres, const ChuteGeometry& chute);
+// [flow count]
+
+/// The front of the flow: the path() reached by the bead ahead of which lie a thousandth of the
+/// beads (at least the first one) — a single bead thrown ahead does not move it [m]. 0 for no
+/// beads.
+double front(std::span<const Vector3> centres, const ChuteGeometry& chute);
+
+/// The times the reference study measures on F(t) [s], each interpolated linearly between the
+/// samples and absent when F never gets there.
+struct FlowTimes {
+  std::optional<double> entry;  ///< F reaches `entry_count` beads (150 in the reference study)
+  std::optional<double> first;  ///< F reaches 1 % of the beads
+  std::optional<double> last;   ///< F reaches 95 % of the beads
+  /// The flow's duration, last − first, when both are there.
+  std::optional<double> duration() const;
+};
+
+/// The flow times of a count F(t) sampled at increasing times `t` among `beads` beads in all.
+/// Throws InvalidArgument for spans of different lengths, times that do not increase, a count
+/// that is negative, not finite or above `beads`, or beads or entry_count not positive and finite.
+FlowTimes flow_times(std::span<const double> t, std::span<const double> count, double beads,
+                     double entry_count = 150.0);
+
+}  // namespace grbd::parallel
