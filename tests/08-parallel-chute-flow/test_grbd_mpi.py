@@ -483,6 +483,29 @@ class Chute(Runs):
             self.assertEqual(result.returncode, 2, (bad, result.stderr))
 
 
+    def test_the_cluster_script_stops_before_its_time_limit_and_goes_on(self):
+        # chapters/08-parallel-chute-flow/chute_full.slurm outside SLURM, on the tiny chute: a time
+        # limit of 3 s, so that the stop file comes at 2.25 s (a quarter before the limit), then
+        # the same script again, which restarts from the checkpoint and finishes.
+        script = os.path.abspath(os.path.join(os.path.dirname(PILE), "..", "..", "chapters",
+                                              "08-parallel-chute-flow", "chute_full.slurm"))
+        scene = os.path.abspath(os.path.join(os.path.dirname(BALLISTIC), "tiny_chute.toml"))
+        env = dict(os.environ, GRBD=os.path.abspath(GRBD), GRBD_PROCESSES="2", GRBD_SECONDS="3",
+                   GRBD_SCENE=scene)
+        first = subprocess.run(["bash", script], cwd=self.dir, env=env, capture_output=True,
+                               text=True, timeout=300)
+        self.assertIn(first.returncode, (0, 4), first.stdout + first.stderr)  # 0: a fast machine
+        if first.returncode == 4:
+            self.assertIn("submit again", first.stdout)
+            self.assertTrue(os.path.exists(self.path("tiny_chute.ckpt.h5")))
+            del env["GRBD_SECONDS"]
+            second = subprocess.run(["bash", script], cwd=self.dir, env=env, capture_output=True,
+                                    text=True, timeout=300)
+            self.assertEqual(second.returncode, 0, second.stdout + second.stderr)
+        result = self.run_ok(0, "chute", self.path("tiny_chute.h5"))
+        self.assertIn("beads past the kink at the end: 400 (100 %)", result.stdout)
+
+
 class Periodic(Runs):
     """A periodic box is the central cell of the box tiled 3 × 3 with its copies."""
 
