@@ -7,6 +7,8 @@
 
 #include "grbd/core/error.hpp"
 
+#include <cmath>
+
 namespace grbd::parallel {
 
 std::size_t flow_count(std::span<const Vector3> centres, const ChuteGeometry& chute) {
@@ -14,6 +16,17 @@ std::size_t flow_count(std::span<const Vector3> centres, const ChuteGeometry& ch
   // Hint: a bead is past the kink when its centre's x is below chute.kink_x (the beads flow
   //   towards −x); count them.
   throw grbd::NotImplemented("Exercise 8.4", "the flow count",
+                             "Chapter 8: Parallel chute flow",
+                             "exercises/08-parallel-chute-flow/chute.cpp");
+}
+
+std::optional<std::array<int, 2>> pixel_of(const CameraGrid& camera, const ChuteGeometry& chute,
+                                           const Vector3& position) {
+  // EXERCISE 8.5: a bead's pixel on the camera grid
+  // Hint: chute.runout(position) gives x', y' (and the height z', which the projection drops);
+  //   the column counts pixels of 1/s downstream from x0, the row pixels of 1/s from y0; use
+  //   std::floor, and answer std::nullopt outside [0, columns) × [0, rows).
+  throw grbd::NotImplemented("Exercise 8.5", "a bead's pixel on the camera grid",
                              "Chapter 8: Parallel chute flow",
                              "exercises/08-parallel-chute-flow/chute.cpp");
 }

@@ -3,6 +3,7 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <numbers>
 #include <optional>
@@ -53,6 +54,78 @@ TEST(Exercise8_4, TheFlowCountIsTheNumberOfBeadsPastTheKink) {
   EXPECT_EQ(flow_count(at, kReference), 1u);
   const ChuteGeometry other{-0.5, 10.0};
   EXPECT_EQ(flow_count(at, other), 0u);
+}
+
+// A bead placed in the run-out's frame at the centre of pixel (i, j), at any height above the
+// floor, is seen in that pixel; the image's edges are half-open; beyond them there is no pixel.
+TEST(Exercise8_5, ABeadIsSeenInThePixelUnderIt) {
+  const CameraGrid camera;  // 800 × 600 at 967.59 px/m from the kink, rows centred on the axis
+  const double a = 10.0 * std::numbers::pi / 180.0;
+  const Vector3 along(std::cos(a), 0.0, -std::sin(a)), normal(std::sin(a), 0.0, std::cos(a));
+  const auto at = [&](double x, double y, double z) -> Vector3 {  // run-out frame → frame I
+    return Vector3(-0.296, 0.0, 0.0) + x * along + Vector3(0.0, y, 0.0) + z * normal;
+  };
+  const double s = camera.pixels_per_metre;
+  for (const auto& [i, j] : std::vector<std::array<int, 2>>{{0, 0}, {17, 300}, {799, 599}}) {
+    for (const double z : {0.0007, 0.02}) {
+      const auto pixel =
+          pixel_of(camera, kReference, at(camera.x0 - (i + 0.5) / s, camera.y0 + (j + 0.5) / s, z));
+      ASSERT_TRUE(pixel.has_value());
+      EXPECT_EQ((*pixel)[0], i);
+      EXPECT_EQ((*pixel)[1], j);
+    }
+  }
+  EXPECT_FALSE(pixel_of(camera, kReference, at(0.001, 0.0, 0.001)));       // upstream of x0
+  EXPECT_FALSE(pixel_of(camera, kReference, at(-800.5 / s, 0.0, 0.001)));  // past the image
+  EXPECT_FALSE(pixel_of(camera, kReference, at(-0.1, camera.y0 - 1e-6, 0.001)));
+  EXPECT_FALSE(pixel_of(camera, kReference, at(-0.1, camera.y0 + 600.5 / s, 0.001)));
+  // The tree the reference places at x' = −0.1254 m on the axis is 121 pixels downstream.
+  EXPECT_EQ((*pixel_of(camera, kReference, at(-0.1254, 0.004, 0.04)))[0], 121);
+}
+
+// Beads moving alike in the run-out's plane give that velocity in every pixel they are in and
+// nothing elsewhere; two beads in one pixel give their mean.
+TEST(VelocityField, IsTheMeanPlanViewVelocityOfTheBeadsInEachPixel) {
+  const CameraGrid camera{40, 30, 100.0, 0.0, -0.15};  // 1 cm pixels
+  const double a = 10.0 * std::numbers::pi / 180.0;
+  const Vector3 along(std::cos(a), 0.0, -std::sin(a)), normal(std::sin(a), 0.0, std::cos(a));
+  const Vector3 kink(-0.296, 0.0, 0.0);
+  std::vector<Vector3> centres, velocities;
+  for (int k = 0; k < 20; ++k) {  // downstream at 1.5 m/s, across at 0.2 m/s, sinking a little
+    centres.push_back(kink - (0.015 + 0.02 * k) * along + 0.001 * normal);
+    velocities.push_back(-1.5 * along + Vector3(0.0, 0.2, 0.0) - 0.05 * normal);
+  }
+  centres.push_back(centres[0] + Vector3(0.0, 0.002, 0.0));  // a second bead in pixel (1, 15)
+  velocities.push_back(-0.5 * along);
+  centres.push_back(kink + 0.5 * along);  // upstream of the image: not seen
+  velocities.push_back(Vector3(9.0, 9.0, 9.0));
+  const VelocityField field = velocity_field(camera, kReference, centres, velocities);
+  ASSERT_EQ(field.count.size(), 1200u);
+  std::size_t seen = 0;
+  for (int j = 0; j < 30; ++j) {
+    for (int i = 0; i < 40; ++i) {
+      const std::size_t k = static_cast<std::size_t>(j * 40 + i);
+      if (field.count[k] == 0) {
+        EXPECT_EQ(field.along[k], 0.0);
+        continue;
+      }
+      seen += field.count[k];
+      EXPECT_EQ(j, 15);
+      if (i == 1) {
+        EXPECT_EQ(field.count[k], 2u);
+        EXPECT_NEAR(field.along[k], 1.0, 1e-12);
+        EXPECT_NEAR(field.across[k], 0.1, 1e-12);
+      } else {
+        EXPECT_NEAR(field.along[k], 1.5, 1e-12);
+        EXPECT_NEAR(field.across[k], 0.2, 1e-12);
+      }
+    }
+  }
+  EXPECT_EQ(seen, 21u);
+  EXPECT_THROW(velocity_field(camera, kReference, centres, std::vector<Vector3>(3)),
+               InvalidArgument);
+  EXPECT_THROW(velocity_field(CameraGrid{0, 30, 100.0, 0.0, 0.0}, kReference, centres, velocities),
+               InvalidArgument);
 }
 
 // The front ignores the thousandth of the beads that runs ahead: of 2000 beads, two.

@@ -36,6 +36,45 @@ double front(std::span<const Vector3> centres, const ChuteGeometry& chute) {
   return s[ahead];
 }
 
+VelocityField velocity_field(const CameraGrid& camera, const ChuteGeometry& chute,
+                             std::span<const Vector3> centres,
+                             std::span<const Vector3> velocities) {
+  if (centres.size() != velocities.size()) {
+    throw InvalidArgument("velocity_field: expected one velocity per centre, found " +
+                          std::to_string(velocities.size()) + " for " +
+                          std::to_string(centres.size()));
+  }
+  if (camera.columns < 1 || camera.rows < 1) {
+    throw InvalidArgument("velocity_field: expected a camera grid of at least one pixel, found " +
+                          std::to_string(camera.columns) + " × " + std::to_string(camera.rows));
+  }
+  require_positive_finite("velocity_field", "pixels_per_metre", camera.pixels_per_metre);
+  VelocityField field{camera, {}, {}, {}};
+  const auto n = static_cast<std::size_t>(camera.columns) * static_cast<std::size_t>(camera.rows);
+  field.along.assign(n, 0.0);
+  field.across.assign(n, 0.0);
+  field.count.assign(n, 0);
+  // A velocity in the run-out's frame: the frame's map less its origin (a rotation).
+  const Vector3 origin = chute.runout(Vector3::Zero());
+  for (std::size_t i = 0; i < centres.size(); ++i) {
+    const auto pixel = pixel_of(camera, chute, centres[i]);
+    if (!pixel) continue;
+    const std::size_t k =
+        static_cast<std::size_t>((*pixel)[1]) * static_cast<std::size_t>(camera.columns) +
+        static_cast<std::size_t>((*pixel)[0]);
+    const Vector3 v = chute.runout(velocities[i]) - origin;
+    field.along[k] -= v.x();  // downstream is −x'
+    field.across[k] += v.y();
+    ++field.count[k];
+  }
+  for (std::size_t k = 0; k < n; ++k) {
+    if (field.count[k] == 0) continue;
+    field.along[k] /= field.count[k];
+    field.across[k] /= field.count[k];
+  }
+  return field;
+}
+
 std::optional<double> FlowTimes::duration() const {
   if (first && last) return *last - *first;
   return std::nullopt;
