@@ -70,6 +70,10 @@ TEST(Communicator, MaxMinAllAny) {
   EXPECT_EQ(world->all(world->rank() != 0), false);
   EXPECT_EQ(world->any(world->rank() == p - 1), true);
   EXPECT_FALSE(world->any(false));
+  // The error agreement: true when every process is fine; false on every process when one failed
+  // and the others arrive (well within the patience, since none waits elsewhere).
+  EXPECT_TRUE(world->agree(true, "unused", kAgreementPatience));
+  EXPECT_FALSE(world->agree(world->rank() != p - 1, "the last rank failed", kAgreementPatience));
 }
 
 TEST(Communicator, BroadcastAndAllGatherHandEveryoneTheSameBytes) {

@@ -20,6 +20,7 @@ namespace grbd::io {
 
 namespace {
 
+using collective::WarmRow;
 using h5::check;
 using h5::Handle;
 
@@ -75,6 +76,13 @@ void add_body(Checksum& sum, const timestep::PackedBody& bytes) {
   }
 }
 
+// A warm start's key for the checksum: its four words, then its periodic image when it has one
+// (version 4; a key of an earlier version has none, so that its checksum reads as before).
+void add_key(Checksum& sum, const timestep::ContactKey& key) {
+  for (std::uint64_t x : {key.a, key.b, key.feature_a, key.feature_b}) sum.add(x);
+  if (key.image != 0) sum.add(key.image);
+}
+
 // Version 2's checksum: every value in one sequence (read, not written, since version 3).
 std::uint64_t sequential_checksum(const Checkpoint& c) {
   const scene::SimulationState& s = c.state;
@@ -94,9 +102,7 @@ std::uint64_t sequential_checksum(const Checkpoint& c) {
     add_body(sum, bytes);
   }
   for (std::size_t k = 0; k < s.warm_keys.size(); ++k) {
-    const timestep::ContactKey& key = s.warm_keys[k];
-    for (std::uint64_t x : {key.a, key.b, key.feature_a, key.feature_b}) sum.add(x);
-    if (key.image != 0) sum.add(key.image);
+    add_key(sum, s.warm_keys[k]);
     for (int d = 0; d < 3; ++d) sum.add(s.warm_lambda[k][d]);
   }
   for (const scene::GeneratorState& g : s.generators) {
@@ -108,12 +114,6 @@ std::uint64_t sequential_checksum(const Checkpoint& c) {
 
 // The columns of a warm start's key: a, b, feature_a, feature_b, image (version 4).
 constexpr std::size_t kKeyColumns = 5;
-
-// A warm start as the checkpoint holds it.
-struct WarmRow {
-  timestep::ContactKey key;
-  double lambda[3];
-};
 
 // [checksum]
 // Version 3's checksum, which processes that each hold some rows form together: the sequence of
@@ -151,10 +151,7 @@ std::uint64_t warm_checksum(std::uint64_t row, const WarmRow& warm) {
   Checksum sum;
   sum.add(std::uint64_t{'w'});
   sum.add(row);
-  for (std::uint64_t x : {warm.key.a, warm.key.b, warm.key.feature_a, warm.key.feature_b}) {
-    sum.add(x);
-  }
-  if (warm.key.image != 0) sum.add(warm.key.image);  // version 4 (a version 3 key has none)
+  add_key(sum, warm.key);
   for (double x : warm.lambda) sum.add(x);
   return sum.value();
 }

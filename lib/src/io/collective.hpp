@@ -16,8 +16,15 @@
 
 #include "grbd/core/communicator.hpp"
 #include "grbd/io/output.hpp"
+#include "grbd/timestep/contacts.hpp"
 
 namespace grbd::io::collective {
+
+/// A warm start as a row of a checkpoint or of a message: its contact's key and percussion.
+struct WarmRow {
+  timestep::ContactKey key;  ///< the contact
+  double lambda[3];          ///< its percussion Λ [N s]
+};
 
 /// Where this process's rows lie in the global order: rows [offset, offset + n) of `total`.
 struct Block {

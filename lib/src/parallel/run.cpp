@@ -124,10 +124,7 @@ void send_to_owners(const Communicator& comm, const SceneDecomposition& decompos
     std::uint64_t id;
     std::int64_t rank;
   };
-  struct Warm {
-    timestep::ContactKey key;
-    double lambda[3];
-  };
+  using Warm = io::collective::WarmRow;
   const auto n = static_cast<std::size_t>(P);
   std::vector<std::vector<std::byte>> bodies(n), owners(n), warm(n), received;
   timestep::PackedBody packed;
