@@ -341,24 +341,13 @@ int chute_command(const std::string& file, const std::optional<std::string>& csv
                   double entry_count) {
   namespace par = grbd::parallel;
   const par::ChuteGeometry chute{kink_x, 10.0};
-  std::vector<double> t, count, fronts, bodies;
   try {
-    const grbd::io::OutputSummary summary = grbd::io::read_summary(file);
-    if (summary.records == 0) throw grbd::io::IoError(file + ": holds no record");
-    std::vector<grbd::Vector3> centres;
-    double beads = 0.0;
-    for (std::uint64_t k = 0; k < summary.records; ++k) {
-      const grbd::io::Record record = grbd::io::read_record(file, k);
-      centres.clear();
-      for (const grbd::body::State& x : record.states) centres.push_back(x.q.head<3>());
-      if (k == 0) beads = static_cast<double>(centres.size());
-      const double removed = std::max(0.0, beads - static_cast<double>(centres.size()));
-      t.push_back(record.t);
-      count.push_back(static_cast<double>(par::flow_count(centres, chute)) + removed);
-      fronts.push_back(par::front(centres, chute));
-      bodies.push_back(static_cast<double>(centres.size()));
-    }
-    if (!(beads > 0.0)) throw grbd::io::IoError(file + ": the first record holds no bead");
+    const par::FlowSeries series = par::flow_series(file, chute);
+    const std::vector<double>& t = series.t;
+    const std::vector<double>& count = series.count;
+    const std::vector<double>& fronts = series.front;
+    const std::vector<double>& bodies = series.bodies;
+    const double beads = series.beads;
     const par::FlowTimes times = par::flow_times(t, count, beads, entry_count);
     if (csv) {
       // Written under a temporary name and renamed once complete: an earlier CSV stays whole.

@@ -7,11 +7,12 @@
 
 #include <algorithm>
 #include <cmath>
-#include <numbers>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <numbers>
 #include <string>
+#include <vector>
 
 #include "grbd/io/checkpoint.hpp"
 #include "grbd/io/output.hpp"
@@ -133,6 +134,71 @@ TEST_F(Folder, RecordsGiveBackTheirStates) {
   }
 }
 
+// What the chapters' analyses read back (chapter 8's ch08_chute, the steady-flow study): every step
+// of /steps as the stepper reported it, and a record's contacts as the simulation held them.
+TEST_F(Folder, StepsAndContactsReadBackAsTheRunHadThem) {
+  auto scene = chute();
+  scene.output.contacts = true;
+  const fs::path file = path("c.h5");
+  Simulation sim(scene);
+  grbd::io::OutputFile out(file, scene);
+  std::vector<grbd::timestep::StepReport> reports;
+  for (int k = 0; k < 120; ++k) {
+    reports.push_back(sim.step());
+    out.add_step(reports.back(), sim.system().size());
+  }
+  out.write_record(sim);
+  grbd::io::RecordPart part;
+  grbd::io::collect_record(sim, true, part);
+  out.close(sim);
+  const std::vector<grbd::io::StepInfo> steps = grbd::io::read_steps(file);
+  ASSERT_EQ(steps.size(), reports.size());
+  for (std::size_t k = 0; k < steps.size(); ++k) {
+    EXPECT_EQ(steps[k].step, reports[k].step);
+    EXPECT_EQ(steps[k].t, reports[k].t);
+    EXPECT_EQ(steps[k].contacts, reports[k].contacts);
+    EXPECT_EQ(steps[k].iterations, reports[k].iterations);
+    EXPECT_EQ(steps[k].converged, reports[k].converged);
+    EXPECT_EQ(steps[k].residual, reports[k].residual);
+    EXPECT_EQ(steps[k].max_penetration, reports[k].max_penetration);
+  }
+  auto expected = part.contacts;
+  ASSERT_GT(expected.size(), 10U);
+  std::sort(expected.begin(), expected.end(),
+            [](const auto& a, const auto& b) { return a.key < b.key; });
+  const std::vector<grbd::io::RecordContact> contacts = grbd::io::read_contacts(file, 0);
+  ASSERT_EQ(contacts.size(), expected.size());
+  for (std::size_t j = 0; j < contacts.size(); ++j) {
+    EXPECT_EQ(contacts[j].key.a, expected[j].key.a);
+    EXPECT_EQ(contacts[j].key.b, expected[j].key.b);
+    EXPECT_EQ(contacts[j].point, expected[j].point);
+    EXPECT_EQ(contacts[j].normal, expected[j].normal);
+    EXPECT_EQ(contacts[j].gap, expected[j].gap);
+    EXPECT_EQ(contacts[j].lambda_N, expected[j].lambda_N);
+    EXPECT_EQ(contacts[j].lambda_T, expected[j].lambda_T);
+    EXPECT_EQ(contacts[j].line, expected[j].line);
+  }
+  // A record that is not there, and a file written without contacts, are refused by name.
+  try {
+    grbd::io::read_contacts(file, 1);
+    ADD_FAILURE() << "record 1 read";
+  } catch (const IoError& e) {
+    EXPECT_NE(std::string(e.what()).find("record 1 asked for"), std::string::npos) << e.what();
+  }
+  scene.output.contacts = false;
+  Simulation plain(scene);
+  grbd::io::OutputFile without(path("p.h5"), scene);
+  without.write_record(plain);
+  without.close(plain);
+  try {
+    grbd::io::read_contacts(path("p.h5"), 0);
+    ADD_FAILURE() << "contacts read from a file without them";
+  } catch (const IoError& e) {
+    EXPECT_NE(std::string(e.what()).find("p.h5"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("holds no contacts"), std::string::npos) << e.what();
+  }
+}
+
 TEST_F(Folder, CheckpointsReplaceEachOtherAtomically) {
   const auto scene = chute();
   Simulation sim(scene);
@@ -238,7 +304,8 @@ TEST_F(Folder, CheckpointsThatContradictThemselvesOrTheSceneAreRefused) {
   EXPECT_NE(state_message(state).find("body " + std::to_string(state.bodies[2].id)),
             std::string::npos);
   state = good;
-  std::get<grbd::collision::Sphere>(state.bodies[1].shape).radius = 0.0065;  // beyond the group's largest
+  std::get<grbd::collision::Sphere>(state.bodies[1].shape).radius =
+      0.0065;  // beyond the group's largest
   EXPECT_NE(state_message(state), "");
   // A value damaged in the file is named as damage by the checksum.
   grbd::io::write_checkpoint(path("f.h5"), {good, {}, scene.text});
@@ -321,7 +388,8 @@ grbd::scene::Scene scene_of(const std::string& statics, const std::string& regio
       "[[material]]\nname = \"glass\"\n[default_contact]\nmu = 0.5\n" +
       statics +
       "[[bodies]]\nname = \"beads\"\nradius = 0.002\ndensity = 2500.0\nmaterial = \"glass\"\n"
-      "[bodies.generator]\nkind = \"lattice\"\nregion = " + region + "\n";
+      "[bodies.generator]\nkind = \"lattice\"\nregion = " +
+      region + "\n";
   return grbd::scene::parse_scene(text, "surface.toml");
 }
 

@@ -941,6 +941,23 @@ OutputSummary read_summary(const std::filesystem::path& path) {
   return s;
 }
 
+std::vector<StepInfo> read_steps(const std::filesystem::path& path) {
+  std::lock_guard lock(hdf5::mutex());
+  hdf5::QuietErrors quiet;
+  const std::string file = path.string();
+  Handle handle = open_output(path, H5F_ACC_RDONLY);
+  std::vector<h5::StepRow> rows;
+  Handle step_type = h5::step_row_type();
+  h5::read_array(handle.get(), "steps", step_type.get(), -1, 0, rows, file);
+  std::vector<StepInfo> steps;
+  steps.reserve(rows.size());
+  for (const h5::StepRow& row : rows) {
+    steps.push_back({row.step, row.t, row.bodies, row.contacts, row.iterations, row.converged != 0,
+                     row.residual, row.max_penetration, row.seconds_total});
+  }
+  return steps;
+}
+
 Record read_record(const std::filesystem::path& path, std::uint64_t index) {
   std::lock_guard lock(hdf5::mutex());
   hdf5::QuietErrors quiet;
@@ -977,6 +994,51 @@ Record read_record(const std::filesystem::path& path, std::uint64_t index) {
     for (int d = 0; d < 4; ++d) x.q[3 + d] = p[4 * k + d];
   }
   return record;
+}
+
+std::vector<RecordContact> read_contacts(const std::filesystem::path& path, std::uint64_t index) {
+  std::lock_guard lock(hdf5::mutex());
+  hdf5::QuietErrors quiet;
+  const std::string file = path.string();
+  Handle handle = open_output(path, H5F_ACC_RDONLY);
+  Handle records = open_group(handle.get(), "records", file);
+  const std::uint64_t count = h5::read_uint(records.get(), "count", file);
+  if (index >= count) {
+    h5::fail(file, "record " + std::to_string(index) + " asked for, the file holds " +
+                       std::to_string(count));
+  }
+  if (h5::read_uint(records.get(), "contacts", file) == 0) {
+    h5::fail(file, "holds no contacts (written without [output] contacts = true)");
+  }
+  const std::string name = record_name(index);
+  Handle group = open_group(records.get(), name.c_str(), file);
+  Handle contacts = open_group(group.get(), "contacts", file);
+  const hid_t g = contacts.get();
+  std::vector<std::uint64_t> ids;
+  std::vector<double> point, normal, gap, lambda_N, lambda_T, line;
+  const std::uint64_t m = h5::read_array(g, "ids", H5T_NATIVE_UINT64, -1, 2, ids, file);
+  const auto rows = static_cast<std::int64_t>(m);
+  h5::read_array(g, "point", H5T_NATIVE_DOUBLE, rows, 3, point, file);
+  h5::read_array(g, "normal", H5T_NATIVE_DOUBLE, rows, 3, normal, file);
+  h5::read_array(g, "gap", H5T_NATIVE_DOUBLE, rows, 0, gap, file);
+  h5::read_array(g, "lambda_N", H5T_NATIVE_DOUBLE, rows, 0, lambda_N, file);
+  h5::read_array(g, "lambda_T", H5T_NATIVE_DOUBLE, rows, 3, lambda_T, file);
+  h5::read_array(g, "line", H5T_NATIVE_DOUBLE, 2 * rows, 3, line, file);
+  std::vector<RecordContact> out(m);
+  for (std::uint64_t j = 0; j < m; ++j) {
+    RecordContact& c = out[j];
+    c.key.a = ids[2 * j];
+    c.key.b = ids[2 * j + 1];
+    c.gap = gap[j];
+    c.lambda_N = lambda_N[j];
+    for (int d = 0; d < 3; ++d) {
+      c.point[d] = point[3 * j + d];
+      c.normal[d] = normal[3 * j + d];
+      c.lambda_T[d] = lambda_T[3 * j + d];
+    }
+    for (int d = 0; d < 6; ++d) c.line[d] = line[6 * j + d];
+  }
+  return out;
 }
 
 }  // namespace grbd::io

@@ -10,6 +10,7 @@
 
 #include "grbd/core/checks.hpp"
 #include "grbd/core/error.hpp"
+#include "grbd/io/output.hpp"
 
 namespace grbd::parallel {
 
@@ -117,6 +118,27 @@ FlowTimes flow_times(std::span<const double> t, std::span<const double> count, d
   }
   return {reaches(t, count, entry_count), reaches(t, count, 0.01 * beads),
           reaches(t, count, 0.95 * beads)};
+}
+
+FlowSeries flow_series(const std::filesystem::path& output, const ChuteGeometry& chute) {
+  const std::string file = output.string();
+  const io::OutputSummary summary = io::read_summary(output);
+  if (summary.records == 0) throw io::IoError(file + ": holds no record");
+  FlowSeries series;
+  std::vector<Vector3> centres;
+  for (std::uint64_t k = 0; k < summary.records; ++k) {
+    const io::Record record = io::read_record(output, k);
+    centres.clear();
+    for (const body::State& x : record.states) centres.push_back(x.q.head<3>());
+    if (k == 0) series.beads = static_cast<double>(centres.size());
+    const double removed = std::max(0.0, series.beads - static_cast<double>(centres.size()));
+    series.t.push_back(record.t);
+    series.bodies.push_back(static_cast<double>(centres.size()));
+    series.count.push_back(static_cast<double>(flow_count(centres, chute)) + removed);
+    series.front.push_back(front(centres, chute));
+  }
+  if (!(series.beads > 0.0)) throw io::IoError(file + ": the first record holds no bead");
+  return series;
 }
 
 }  // namespace grbd::parallel

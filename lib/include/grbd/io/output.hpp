@@ -239,6 +239,22 @@ struct OutputSummary {
 /// Reads the summary of an output file (IoError naming the file and dataset when it is not one).
 OutputSummary read_summary(const std::filesystem::path& path);
 
+/// One step of an output file's /steps table, as an analysis of the run reads it.
+struct StepInfo {
+  std::uint64_t step = 0;        ///< the step's number
+  double t = 0.0;                ///< the time at its end [s]
+  std::uint64_t bodies = 0;      ///< bodies in the system
+  std::uint64_t contacts = 0;    ///< contacts solved
+  std::int32_t iterations = 0;   ///< sweeps of the solver
+  bool converged = false;        ///< whether it reached its tolerance
+  double residual = 0.0;         ///< the solver's last residual
+  double max_penetration = 0.0;  ///< max(0, −g_N) over the contacts at the midpoint [m]
+  double seconds = 0.0;          ///< wall time of the step [s]
+};
+
+/// Reads every step of an output file (IoError naming the file when it is not one).
+std::vector<StepInfo> read_steps(const std::filesystem::path& path);
+
 /// One record read back: the global ids and the states, rows in ascending id.
 struct Record {
   double t = 0.0;                   ///< time [s]
@@ -250,5 +266,10 @@ struct Record {
 
 /// Reads record `index` (< records) of an output file.
 Record read_record(const std::filesystem::path& path, std::uint64_t index);
+
+/// Reads the contacts of record `index` of an output file written with [output] contacts (IoError
+/// naming the file otherwise): the file keeps of a contact's key the ids of sides a and b, so the
+/// features and the image of the keys read back are 0.
+std::vector<RecordContact> read_contacts(const std::filesystem::path& path, std::uint64_t index);
 
 }  // namespace grbd::io

@@ -6,6 +6,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <filesystem>
 #include <optional>
 #include <span>
 #include <vector>
@@ -91,5 +92,19 @@ struct FlowTimes {
 /// that is negative, not finite or above `beads`, or beads or entry_count not positive and finite.
 FlowTimes flow_times(std::span<const double> t, std::span<const double> count, double beads,
                      double entry_count = 150.0);
+
+/// A chute run's flow record by record, as its output file holds it.
+struct FlowSeries {
+  double beads = 0.0;          ///< beads in the first record
+  std::vector<double> t;       ///< time of each record [s]
+  std::vector<double> bodies;  ///< beads left in each record (the outlet removes some)
+  /// F: the beads past the kink (flow_count), those the outlet removed counted as past
+  std::vector<double> count;
+  std::vector<double> front;  ///< front() of each record [m]
+};
+
+/// The flow series of the output file of a chute run (io::IoError naming the file when it is not
+/// one, holds no record or no bead in its first).
+FlowSeries flow_series(const std::filesystem::path& output, const ChuteGeometry& chute);
 
 }  // namespace grbd::parallel
