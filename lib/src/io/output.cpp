@@ -953,7 +953,7 @@ std::vector<StepInfo> read_steps(const std::filesystem::path& path) {
   steps.reserve(rows.size());
   for (const h5::StepRow& row : rows) {
     steps.push_back({row.step, row.t, row.bodies, row.contacts, row.iterations, row.converged != 0,
-                     row.residual, row.max_penetration, row.seconds_total});
+                     row.residual, row.max_penetration, row.kinetic_energy, row.seconds_total});
   }
   return steps;
 }

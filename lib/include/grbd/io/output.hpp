@@ -249,6 +249,7 @@ struct StepInfo {
   bool converged = false;        ///< whether it reached its tolerance
   double residual = 0.0;         ///< the solver's last residual
   double max_penetration = 0.0;  ///< max(0, −g_N) over the contacts at the midpoint [m]
+  double kinetic_energy = 0.0;   ///< of the bodies at the end of the step [J]
   double seconds = 0.0;          ///< wall time of the step [s]
 };
 
