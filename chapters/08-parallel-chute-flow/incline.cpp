@@ -60,7 +60,9 @@ struct Flow {
   double froude = 0.0;                                        // ū/√(g h)
   std::vector<double> bulk_i, bulk_mu;                        // per bulk slab
   double seconds = 0.0;
-  bool stopped = false;  // the layer came to rest: no steady flow at this angle and depth
+  double penetration = 0.0;  // the largest over the steps of the second half [m]
+  double sweeps = 0.0;       // the solver's mean over the steps of the second half
+  bool stopped = false;      // the layer came to rest: no steady flow at this angle and depth
 };
 
 // The height of a surface where `phi` falls to `level`, interpolated between slab centres.
@@ -300,6 +302,10 @@ void measure_all(const std::filesystem::path& dir, const grbd::scene::Scene& bas
       }
     }
     const double change = energy_change(steps);
+    for (std::size_t k = steps.size() / 2; k < steps.size(); ++k) {
+      flow.penetration = std::max(flow.penetration, steps[k].max_penetration);
+      flow.sweeps += steps[k].iterations / static_cast<double>(steps.size() - steps.size() / 2);
+    }
     if (flow.stopped) {
       std::printf("%s: theta = %g deg: the layer of %.1f grains came to rest\n", kProgram, angle,
                   flow.depth / 0.002);
@@ -358,6 +364,8 @@ void measure_all(const std::filesystem::path& dir, const grbd::scene::Scene& bas
     }
     values.set(k + "energy_change", "%+.0f", changes[f]);
     values.set(k + "minutes", "%.1f", flow.seconds / 60.0);
+    values.set(k + "penetration_mm", "%.2f", flow.penetration * 1e3);
+    values.set(k + "sweeps", "%.0f", flow.sweeps);
   }
   study.finish();
   std::string rest;
