@@ -958,19 +958,39 @@ std::vector<StepInfo> read_steps(const std::filesystem::path& path) {
   return steps;
 }
 
-Record read_record(const std::filesystem::path& path, std::uint64_t index) {
-  std::lock_guard lock(hdf5::mutex());
-  hdf5::QuietErrors quiet;
+namespace {
+
+// Record `index` of an output file opened to read (IoError naming the file when it holds no such
+// record): the file, its group records and the record's group, open together. Under
+// hdf5::mutex().
+struct OpenRecord {
+  Handle file;     // the output file
+  Handle records;  // its group records
+  Handle group;    // the record's group
+};
+
+OpenRecord open_record(const std::filesystem::path& path, std::uint64_t index) {
   const std::string file = path.string();
-  Handle handle = open_output(path, H5F_ACC_RDONLY);
-  Handle records = open_group(handle.get(), "records", file);
-  const std::uint64_t count = h5::read_uint(records.get(), "count", file);
+  OpenRecord open{open_output(path, H5F_ACC_RDONLY), {}, {}};
+  open.records = open_group(open.file.get(), "records", file);
+  const std::uint64_t count = h5::read_uint(open.records.get(), "count", file);
   if (index >= count) {
     h5::fail(file, "record " + std::to_string(index) + " asked for, the file holds " +
                        std::to_string(count));
   }
   const std::string name = record_name(index);
-  Handle group = open_group(records.get(), name.c_str(), file);
+  open.group = open_group(open.records.get(), name.c_str(), file);
+  return open;
+}
+
+}  // namespace
+
+Record read_record(const std::filesystem::path& path, std::uint64_t index) {
+  std::lock_guard lock(hdf5::mutex());
+  hdf5::QuietErrors quiet;
+  const std::string file = path.string();
+  const OpenRecord open = open_record(path, index);
+  const Handle& group = open.group;
   Record record;
   record.t = h5::read_double(group.get(), "time", file);
   record.step = h5::read_uint(group.get(), "step", file);
@@ -1000,19 +1020,11 @@ std::vector<RecordContact> read_contacts(const std::filesystem::path& path, std:
   std::lock_guard lock(hdf5::mutex());
   hdf5::QuietErrors quiet;
   const std::string file = path.string();
-  Handle handle = open_output(path, H5F_ACC_RDONLY);
-  Handle records = open_group(handle.get(), "records", file);
-  const std::uint64_t count = h5::read_uint(records.get(), "count", file);
-  if (index >= count) {
-    h5::fail(file, "record " + std::to_string(index) + " asked for, the file holds " +
-                       std::to_string(count));
-  }
-  if (h5::read_uint(records.get(), "contacts", file) == 0) {
+  const OpenRecord open = open_record(path, index);
+  if (h5::read_uint(open.records.get(), "contacts", file) == 0) {
     h5::fail(file, "holds no contacts (written without [output] contacts = true)");
   }
-  const std::string name = record_name(index);
-  Handle group = open_group(records.get(), name.c_str(), file);
-  Handle contacts = open_group(group.get(), "contacts", file);
+  Handle contacts = open_group(open.group.get(), "contacts", file);
   const hid_t g = contacts.get();
   std::vector<std::uint64_t> ids;
   std::vector<double> point, normal, gap, lambda_N, lambda_T, line;
