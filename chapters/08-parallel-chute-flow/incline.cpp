@@ -1,26 +1,24 @@
 // Chapter 8 demo: steady flow down a rough incline, and the laws of dense granular flow.
 //
-// incline.toml is a layer of glass beads on a base of fixed beads, in a box periodic along and
-// across the flow. For each angle θ given on the command line the demo tilts its gravity to θ
-// (g (sin θ, 0, −cos θ), the flow along +x) and runs it with grbd's driver of `grbd run` — on the
-// parallel engine, on every process it was started on (mpiexec -n P ch08_incline …) — into
-// incline_<θ>.h5 in the data directory, with the contacts in its records. Rank 0 then measures
-// each run over the second half of its time, when the flow is steady: the profiles across the
-// depth in slabs of half a grain (parallel::DepthProfile: solid fraction, velocity, the stresses
-// of the contact percussions and of the weight above), the layer's base and surface, Bagnold's
-// profile fitted to the velocity (Exercise 8.6), the stress ratio and the inertial number in the
-// bulk (Exercise 8.7); and over all angles the friction law μ(I).
+// ch08_incline_run has run incline.toml — a layer of glass beads on a base of fixed beads, in a
+// box periodic along and across the flow — tilted to each angle θ (g (sin θ, 0, −cos θ), the flow
+// along +x) into incline_<θ>.h5 in the data directory, with the contacts in its records. This
+// program measures each run over the second half of its time, when the flow is steady: the
+// profiles across the depth in slabs of half a grain (parallel::DepthProfile: solid fraction,
+// velocity, the stresses of the contact percussions and of the weight above), the layer's base
+// and surface, Bagnold's profile fitted to the velocity (Exercise 8.6), the stress ratio and the
+// inertial number in the bulk (Exercise 8.7), the solver's work; and over all angles the friction
+// law μ(I).
 //
 // The base: the top of the fixed beads, the bodies whose velocity is exactly zero (a moving bead
 // never has all three components exactly zero). The surface: the height where the solid fraction
 // falls to half the bulk's. The bulk: the slabs from 20 % to 80 % of the depth h.
 //
-// Output in the data directory: incline_<θ>.h5/.xmf (the runs), profile_<θ>.csv (z above the
-// base, φ, u, σ_xz, σ_zz, the weight's σ_zz, the fitted Bagnold u, the local μ and I), energy.csv
-// (t and kinetic energy per bead of each run), study.csv (one line per angle) and values.txt.
+// Output in the data directory: profile_<θ>.csv (z above the base, φ, u, σ_xz, σ_zz, the weight's
+// σ_zz, the fitted Bagnold u, the local μ and I), energy.csv (t and kinetic energy per body of
+// each run), study.csv (one line per flowing angle), mu_points.csv, mu_fit.csv and values.txt.
 //
-// Usage: `[mpiexec -n P] ch08_incline <data directory> run <scene.toml> <angle in degrees>...`
-// (the runs), then `ch08_incline <data directory> measure <scene.toml> <angle>...` (the study).
+// Usage: `ch08_incline <data directory> <scene.toml> <angle in degrees>...`.
 
 #include <algorithm>
 #include <cmath>
@@ -46,7 +44,6 @@ constexpr const char* kProgram = "ch08_incline";
 
 struct Flow {
   double angle = 0.0;         // θ [°]
-  double base = 0.0;          // z of the base's top [m]
   double depth = 0.0;         // h [m]
   double packing = 0.0;       // bulk φ
   double mean_u = 0.0;        // depth-averaged velocity [m/s]
@@ -91,8 +88,8 @@ Flow measure(const std::filesystem::path& output, const grbd::scene::Scene& scen
   }
   const double bin = 0.5 * diameter;
   const double top = 0.1;  // the profiles reach 10 cm
-  par::DepthProfile profile(0.0, bin, static_cast<std::size_t>(std::ceil(top / bin)), area,
-                            density);
+  const auto bins = static_cast<std::size_t>(std::ceil(top / bin));
+  par::DepthProfile profile(0.0, bin, bins, area, density);
   Flow flow;
   flow.angle = angle;
   std::vector<Vector3> centres, velocities;
@@ -112,7 +109,7 @@ Flow measure(const std::filesystem::path& output, const grbd::scene::Scene& scen
     profile.add_bodies(centres, velocities, radii);
     const std::vector<grbd::io::RecordContact> contacts = grbd::io::read_contacts(output, k);
     profile.add_contacts(contacts, scene.settings.dt);
-    samples.emplace_back(0.0, bin, profile.z().size(), area, density);
+    samples.emplace_back(0.0, bin, bins, area, density);
     samples.back().add_contacts(contacts, scene.settings.dt);
   }
   // The fixed beads' radius is the largest radius of the fixed group.
@@ -133,7 +130,6 @@ Flow measure(const std::filesystem::path& output, const grbd::scene::Scene& scen
     bulk_phi /= std::max(n, 1);
   }
   const double surface = surface_height(z, phi, 0.5 * bulk_phi, first);
-  flow.base = base;
   flow.depth = surface - base;
   const double h = flow.depth;
   // Depth averages over the slabs in the layer, the Bagnold fit over the same.

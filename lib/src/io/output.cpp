@@ -890,6 +890,24 @@ Hdf5Cleanup::~Hdf5Cleanup() {
   if (H5Fget_obj_count(H5F_OBJ_ALL, H5F_OBJ_FILE) == 0) H5close();
 }
 
+namespace {
+
+// Every row of the /steps table of an open output file, as StepInfo. Under hdf5::mutex().
+std::vector<StepInfo> step_infos(hid_t root, const std::string& file) {
+  std::vector<h5::StepRow> rows;
+  Handle step_type = h5::step_row_type();
+  h5::read_array(root, "steps", step_type.get(), -1, 0, rows, file);
+  std::vector<StepInfo> steps;
+  steps.reserve(rows.size());
+  for (const h5::StepRow& row : rows) {
+    steps.push_back({row.step, row.t, row.bodies, row.contacts, row.iterations, row.converged != 0,
+                     row.residual, row.max_penetration, row.kinetic_energy, row.seconds_total});
+  }
+  return steps;
+}
+
+}  // namespace
+
 OutputSummary read_summary(const std::filesystem::path& path) {
   std::lock_guard lock(hdf5::mutex());
   hdf5::QuietErrors quiet;
@@ -908,11 +926,10 @@ OutputSummary read_summary(const std::filesystem::path& path) {
     Handle bodies = open_dataset(root, "bodies", file);
     s.bodies = h5::rows(bodies.get(), file, "bodies");
   }
-  std::vector<h5::StepRow> steps;
-  Handle step_type = h5::step_row_type();
-  s.steps = h5::read_array(root, "steps", step_type.get(), -1, 0, steps, file);
+  const std::vector<StepInfo> steps = step_infos(root, file);
+  s.steps = steps.size();
   double iterations = 0.0;
-  for (const h5::StepRow& row : steps) {
+  for (const StepInfo& row : steps) {
     s.max_contacts = std::max<std::uint64_t>(s.max_contacts, row.contacts);
     s.max_iterations = std::max<std::uint64_t>(
         s.max_iterations, static_cast<std::uint64_t>(std::max(row.iterations, 0)));
@@ -923,7 +940,7 @@ OutputSummary read_summary(const std::filesystem::path& path) {
           s.non_converged_iterations, static_cast<std::uint64_t>(std::max(row.iterations, 0)));
     }
     s.max_penetration = std::max(s.max_penetration, row.max_penetration);
-    s.seconds += row.seconds_total;
+    s.seconds += row.seconds;
   }
   if (!steps.empty()) s.mean_iterations = iterations / static_cast<double>(steps.size());
   if (s.records > 0) {
@@ -946,16 +963,7 @@ std::vector<StepInfo> read_steps(const std::filesystem::path& path) {
   hdf5::QuietErrors quiet;
   const std::string file = path.string();
   Handle handle = open_output(path, H5F_ACC_RDONLY);
-  std::vector<h5::StepRow> rows;
-  Handle step_type = h5::step_row_type();
-  h5::read_array(handle.get(), "steps", step_type.get(), -1, 0, rows, file);
-  std::vector<StepInfo> steps;
-  steps.reserve(rows.size());
-  for (const h5::StepRow& row : rows) {
-    steps.push_back({row.step, row.t, row.bodies, row.contacts, row.iterations, row.converged != 0,
-                     row.residual, row.max_penetration, row.kinetic_energy, row.seconds_total});
-  }
-  return steps;
+  return step_infos(handle.get(), file);
 }
 
 namespace {
