@@ -421,7 +421,7 @@ class Chute(Runs):
 
     def test_the_tiny_chute_keeps_every_bead_and_measures_its_flow(self):
         entries = []
-        for p in (0, 2):
+        for p in (0, 2, 3):
             out, ckpt, csv, report = self.run_chute(p)
             with h5py.File(out, "r") as f, h5py.File(ckpt, "r") as c:
                 mass = dict(zip(f["bodies"]["id"][()].tolist(), f["bodies"]["mass"][()].tolist()))
@@ -460,9 +460,10 @@ class Chute(Runs):
             entry = float(re.search(r"entry \(150 beads past the kink\): ([0-9.]+) s",
                                     report).group(1))
             entries.append(entry)
-        # Two processes do not step bit for bit as one (contacts solved in another order), but
-        # the flow arrives at the same time, to a record's spacing.
-        self.assertLess(abs(entries[1] - entries[0]), 0.02, entries)
+        # Two or three processes do not step bit for bit as one (contacts solved in another
+        # order), but the flow arrives at the same time, to a record's spacing.
+        for entry in entries[1:]:
+            self.assertLess(abs(entry - entries[0]), 0.02, entries)
 
 
     def test_grbd_chute_refuses_what_is_not_an_output_and_keeps_an_earlier_csv(self):
@@ -509,14 +510,14 @@ class Chute(Runs):
 
 class Incline(Runs):
     """The tiny incline end to end (data/tiny_incline.toml): 150 beads on a base of 16 fixed ones
-    in a box periodic along and across the flow, tilted 24°, serially and on 2 processes."""
+    in a box periodic along and across the flow, tilted 24°, serially and on 2 and 3 processes."""
 
     L, THETA, G, BEADS, BASE = 0.0092, math.radians(24.0), 9.81, 150, 16
 
     def test_the_tiny_incline_keeps_every_bead_and_starts_to_flow(self):
         scene = os.path.join(os.path.dirname(BALLISTIC), "tiny_incline.toml")
         speeds, heights = [], []
-        for p in (0, 2):
+        for p in (0, 2, 3):
             out = self.path(f"i{p}.h5")
             self.run_ok(p, "run", scene, "-q", "-o", out, "-c", self.path(f"i{p}.c.h5"))
             with h5py.File(out, "r") as f:
@@ -548,11 +549,12 @@ class Incline(Runs):
                 self.assertGreater(mean, 0.02, f"P = {p}")
                 speeds.append(mean)
                 heights.append(float(x[~on_base, 2].mean()))
-        # Two processes do not step bit for bit as one (contacts solved in another order, split
-        # beads averaged), and the onset of a flow amplifies the difference: the two layers settle
-        # to the same height to 2 %, and start to flow at the same speed to 30 %.
-        self.assertLess(abs(heights[1] - heights[0]), 0.02 * heights[0], heights)
-        self.assertLess(abs(speeds[1] - speeds[0]), 0.3 * speeds[0], speeds)
+        # Two or three processes do not step bit for bit as one (contacts solved in another order,
+        # split beads averaged), and the onset of a flow amplifies the difference: the layers
+        # settle to the same height to 2 %, and start to flow at the same speed to 30 %.
+        for height, speed in zip(heights[1:], speeds[1:]):
+            self.assertLess(abs(height - heights[0]), 0.02 * heights[0], heights)
+            self.assertLess(abs(speed - speeds[0]), 0.3 * speeds[0], speeds)
 
 
 class Periodic(Runs):
@@ -613,7 +615,7 @@ class Periodic(Runs):
                                      for k in range(int(f["records"].attrs["count"]))))
         self.assertGreater(across, 0, "no contact across the boundary: nothing was tested")
         box = self.scene("box.toml", [(0, 0)], periodic=True)
-        for p in (0, 2):  # the parallel engine on one process (no mpiexec), and on two
+        for p in (0, 2, 3):  # the parallel engine on one process (no mpiexec), on two and three
             out = self.path(f"p{p}.h5")
             self.run_ok(p, "run", box, "-q", "-o", out, "-c", self.path(f"p{p}.c.h5"))
             x, v, contacts = self.last(out)
@@ -685,7 +687,7 @@ class Periodic(Runs):
         with open(scene, "w") as f:
             f.write(text)
         mass = 2500.0 * 4.0 / 3.0 * np.pi * r**3
-        for p in (0, 2):
+        for p in (0, 2, 3):
             out, ckpt = self.path(f"chain{p}.h5"), self.path(f"chain{p}.c.h5")
             self.run_ok(p, "run", scene, "-q", "-o", out, "-c", ckpt)
             with h5py.File(out, "r") as f:
