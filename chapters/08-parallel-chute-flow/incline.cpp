@@ -10,9 +10,8 @@
 // inertial number in the bulk (Exercise 8.7), the solver's work; and over all angles the friction
 // law μ(I).
 //
-// The base: the top of the fixed beads, the bodies whose velocity is exactly zero (a moving bead
-// never has all three components exactly zero). The surface: the height where the solid fraction
-// falls to half the bulk's. The bulk: the slabs from 20 % to 80 % of the depth h.
+// The base, the surface and the depth h: incline::layer_profile. The bulk: the slabs from 20 % to
+// 80 % of the depth h.
 //
 // Output in the data directory: profile_<θ>.csv (z above the base, φ, u, σ_xz, σ_zz, the weight's
 // σ_zz, the fitted Bagnold u, the local μ and I), energy.csv (t and kinetic energy per body of
@@ -38,7 +37,6 @@
 namespace {
 
 namespace par = grbd::parallel;
-using grbd::Vector3;
 
 constexpr const char* kProgram = "ch08_incline";
 
@@ -62,87 +60,38 @@ struct Flow {
   bool stopped = false;      // the layer came to rest: no steady flow at this angle and depth
 };
 
-// The height of a surface where `phi` falls to `level`, interpolated between slab centres.
-double surface_height(const std::vector<double>& z, const std::vector<double>& phi, double level,
-                      std::size_t from) {
-  for (std::size_t k = from + 1; k < phi.size(); ++k) {
-    if (phi[k] < level && phi[k - 1] >= level) {
-      return z[k - 1] + (z[k] - z[k - 1]) * (phi[k - 1] - level) / (phi[k - 1] - phi[k]);
-    }
-  }
-  throw grbd::Error("no free surface in the profile: the layer fills the box");
-}
-
 Flow measure(const std::filesystem::path& output, const grbd::scene::Scene& scene, double angle,
              const std::filesystem::path& csv) {
   const grbd::io::OutputSummary summary = grbd::io::read_summary(output);
   if (summary.records < 4) throw grbd::Error(output.string() + ": too few records to average");
-  const auto& box = scene.domain.box;
-  const double area = (box.max.x() - box.min.x()) * (box.max.y() - box.min.y());
-  double density = 0.0, diameter = 0.0;
-  for (const auto& g : scene.groups) {
-    if (!g.fixed) {
-      density = *g.density;
-      diameter = g.radius.min() + g.radius.max();  // the mean of a uniform distribution, twice
-    }
-  }
-  const double bin = 0.5 * diameter;
-  const double top = 0.1;  // the profiles reach 10 cm
-  const auto bins = static_cast<std::size_t>(std::ceil(top / bin));
-  par::DepthProfile profile(0.0, bin, bins, area, density);
+  // The second half's profiles, and each record's contacts alone (for the errors).
+  std::vector<par::DepthProfile> samples;
+  const incline::Profile p = incline::layer_profile(
+      output, scene, summary.records / 2, true,
+      [&](const incline::Profile& so_far, const std::vector<grbd::io::RecordContact>& contacts) {
+        samples.emplace_back(0.0, so_far.bin, so_far.bins, so_far.area, so_far.density);
+        samples.back().add_contacts(contacts, scene.settings.dt);
+      });
   Flow flow;
   flow.angle = angle;
-  std::vector<Vector3> centres, velocities;
-  std::vector<double> radii;
-  double base = 0.0;
-  std::vector<par::DepthProfile> samples;  // each record's contacts alone, for the errors
-  for (std::uint64_t k = summary.records / 2; k < summary.records; ++k) {
-    const grbd::io::Record record = grbd::io::read_record(output, k);
-    centres.clear();
-    velocities.clear();
-    for (const auto& x : record.states) {
-      centres.push_back(x.q.head<3>());
-      velocities.push_back(x.u.head<3>());
-      if (x.u.head<3>().isZero(0.0)) base = std::max(base, x.q.z());
-    }
-    radii = record.radius;
-    profile.add_bodies(centres, velocities, radii);
-    const std::vector<grbd::io::RecordContact> contacts = grbd::io::read_contacts(output, k);
-    profile.add_contacts(contacts, scene.settings.dt);
-    samples.emplace_back(0.0, bin, bins, area, density);
-    samples.back().add_contacts(contacts, scene.settings.dt);
-  }
-  // The fixed beads' radius is the largest radius of the fixed group.
-  for (const auto& g : scene.groups) {
-    if (g.fixed) base += g.radius.max();
-  }
   const double g = scene.settings.I_g.norm();
   const double g_normal = g * std::cos(angle * std::numbers::pi / 180.0);
-  const std::vector<double> z = profile.z(), phi = profile.packing(), u = profile.velocity(),
-                            sxz = profile.shear_stress(), szz = profile.normal_stress(),
-                            weight = profile.weight_stress(g_normal);
-  std::size_t first = 0;
-  while (first < z.size() && z[first] < base) ++first;
-  double bulk_phi = 0.0;
-  {
-    int n = 0;
-    for (std::size_t k = first + 2; k < first + 8 && k < z.size(); ++k, ++n) bulk_phi += phi[k];
-    bulk_phi /= std::max(n, 1);
-  }
-  const double surface = surface_height(z, phi, 0.5 * bulk_phi, first);
-  flow.depth = surface - base;
+  const double diameter = p.diameter, density = p.density, bin = p.bin, base = p.base,
+               surface = p.surface;
+  const std::size_t first = p.first;
+  const std::vector<double> z = p.depth.z(), phi = p.depth.packing(), u = p.depth.velocity(),
+                            sxz = p.depth.shear_stress(), szz = p.depth.normal_stress(),
+                            weight = p.depth.weight_stress(g_normal);
+  flow.depth = p.height();
   const double h = flow.depth;
-  // Depth averages over the slabs in the layer, the Bagnold fit over the same.
+  // The Bagnold fit over the slabs in the layer.
   std::vector<double> zl, ul;
-  double sum_u = 0.0, sum_w = 0.0;
   for (std::size_t k = first; k < z.size() && z[k] <= surface; ++k) {
     zl.push_back(z[k] - base);
     ul.push_back(u[k]);
-    sum_u += u[k];
-    sum_w += 1.0;
-    flow.surface_u = u[k];
   }
-  flow.mean_u = sum_u / sum_w;
+  flow.mean_u = p.mean_u;
+  flow.surface_u = p.surface_u;
   if (flow.surface_u < 1e-3 * std::sqrt(g * diameter)) {  // at rest: nothing more to measure
     flow.stopped = true;
     return flow;
@@ -264,18 +213,6 @@ MuFit fit_mu(const std::vector<double>& I, const std::vector<double>& mu, double
 
 double degrees(double x) { return std::atan(x) * 180.0 / std::numbers::pi; }
 
-// The kinetic energy's change over the averaged second half of a run [%]: the mean of its last
-// tenth over the mean of the tenth that starts at the half.
-double energy_change(const std::vector<grbd::io::StepInfo>& steps) {
-  const std::size_t n = steps.size(), w = std::max<std::size_t>(n / 10, 1);
-  double early = 0.0, late = 0.0;
-  for (std::size_t k = 0; k < w; ++k) {
-    early += steps[n / 2 + k].kinetic_energy;
-    late += steps[n - 1 - k].kinetic_energy;
-  }
-  return 100.0 * (late / early - 1.0);
-}
-
 // `measure`: the runs' files measured, the study's tables and values.
 void measure_all(const std::filesystem::path& dir, const grbd::scene::Scene& base,
                  const std::vector<double>& angles) {
@@ -297,7 +234,7 @@ void measure_all(const std::filesystem::path& dir, const grbd::scene::Scene& bas
                << '\n';
       }
     }
-    const double change = energy_change(steps);
+    const double change = incline::energy_change(steps);
     for (std::size_t k = steps.size() / 2; k < steps.size(); ++k) {
       flow.penetration = std::max(flow.penetration, steps[k].max_penetration);
       flow.sweeps += steps[k].iterations / static_cast<double>(steps.size() - steps.size() / 2);
