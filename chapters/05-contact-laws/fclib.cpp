@@ -52,7 +52,8 @@ namespace fs = std::filesystem;
 constexpr const char* kProgram = "ch05_fclib";
 constexpr const char* kUsage =
     "usage: ch05_fclib <data directory> <FCLIB file or folder>... [--tol T] [--max-iterations N]\n"
-    "  solves FCLIB problems with SOR, JOR and APGD; writes fclib.txt, fclib.csv and values.txt\n";
+    "  solves FCLIB problems with SOR, JOR, APGD and Newton; writes fclib.txt, fclib.csv and "
+    "values.txt\n";
 
 /// CLI11's help, which starts with the usage line of the other demos instead of CLI11's own.
 class Help : public CLI::Formatter {
@@ -196,6 +197,7 @@ int main(int argc, char** argv) {
                  row.relative_residual);
       values.set(key + "scaled", "%.1e", row.scaled_residual);
       values.set(key + "ms", "%.3g", 1e3 * row.seconds);
+      values.set(key + "linear", "%d", row.linear_iterations);  // Newton's linear solves' work
       char line[512];
       for (std::size_t k = 0; k < row.history.size(); ++k) {
         std::snprintf(line, sizeof line, "%s,%s,%zu,%.6e\n", row.problem.c_str(),

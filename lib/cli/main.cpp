@@ -635,7 +635,7 @@ int grbd_main(int argc, char** argv) {
   int fclib_max_iterations = 20000;
   std::optional<std::string> fclib_csv;
   CLI::App* fclib = app.add_subcommand(
-      "fclib", "Solve FCLIB problems with SOR, JOR and APGD (chapter 5's bench): a table");
+      "fclib", "Solve FCLIB problems with SOR, JOR, APGD and Newton (chapter 5's bench): a table");
   fclib->add_option("problems", fclib_inputs, "FCLIB files (HDF5), or folders of *.hdf5 files")
       ->required();
   fclib->add_option("--tol", fclib_tol, "Stop once |F| <= tol |q| (natural map), default 1e-8")

@@ -17,6 +17,7 @@
 #include "grbd/contact/fclib.hpp"
 #include "grbd/contact/prox.hpp"
 #include "grbd/contact/solver.hpp"
+#include "grbd_test/fclib_data.hpp"
 
 namespace {
 
@@ -25,24 +26,10 @@ using grbd::contact::LocalProblem;
 using grbd::contact::SolverOptions;
 using grbd::contact::SolverResult;
 
-std::filesystem::path data_file(const std::string& name) {
-  return std::filesystem::path(GRBD_FCLIB_DATA_DIR) / name;
-}
+using grbd::test::norm;
+using grbd::test::to_tolerance;
 
-SolverOptions to_tolerance(double tol, int max_iterations) {
-  SolverOptions options;
-  options.criterion = grbd::contact::Criterion::natural_residual;
-  options.abs_tol = 0.0;
-  options.rel_tol = tol;
-  options.max_iterations = max_iterations;
-  return options;
-}
-
-double norm(const std::vector<Vector3>& v) {
-  double sum = 0.0;
-  for (const Vector3& x : v) sum += x.squaredNorm();
-  return std::sqrt(sum);
-}
+std::filesystem::path data_file(const std::string& name) { return grbd::test::fclib_file(name); }
 
 /// Solves, then checks the result independently: the residual recomputed from ξ = Wλ + q, the
 /// percussions inside the cone, and the Siconos bound. `solver` is "SOR" or "APGD". Returns ξ.

@@ -92,6 +92,8 @@ SolverResult solve(Method m, const ContactProblem& p, ContactSolution& s, const 
       return grbd::contact::solve_jor(p, s, o);
     case Method::apgd:
       return grbd::contact::solve_apgd(p, s, o);
+    case Method::newton:
+      return grbd::contact::solve_newton(p, s, o);
   }
   return {};
 }
@@ -413,6 +415,7 @@ TEST(SolverDriver, ConstructorValidatesOnceAndNamesTheMethod) {
   EXPECT_EQ(grbd::contact::method_name(Method::sor), "SOR");
   EXPECT_EQ(grbd::contact::method_name(Method::jor), "JOR");
   EXPECT_EQ(grbd::contact::method_name(Method::apgd), "APGD");
+  EXPECT_EQ(grbd::contact::method_name(Method::newton), "Newton");
   SolverOptions o;
   o.alpha = 0.4;
   o.r_strategy = RFactorStrategy::spectral;

@@ -60,6 +60,7 @@ using grbd::Vector6;
 using grbd::contact::ContactProblem;
 using grbd::contact::ContactSolution;
 using grbd::contact::Criterion;
+using grbd::contact::LinearSolver;
 using grbd::contact::LocalProblem;
 using grbd::contact::ProxForm;
 using grbd::contact::RFactorStrategy;
@@ -74,7 +75,7 @@ using Eigen::VectorXd;
 // The inequalities of the contact law are checked to this many times rel_tol ‖c‖.
 constexpr double kLawFactor = 10.0;
 
-enum class Kind { sor, jor, apgd };
+enum class Kind { sor, jor, apgd, newton };
 
 // A solver with its settings.
 struct Method {
@@ -83,6 +84,7 @@ struct Method {
   ProxForm form = ProxForm::alart_curnier;
   RFactorStrategy strategy = RFactorStrategy::per_contact;
   double alpha = 1.0;
+  LinearSolver linear = LinearSolver::automatic;  // Newton's
 };
 
 // Every problem is solved with these. JOR needs a small step: α = 0.3, per contact or with the
@@ -95,6 +97,11 @@ const Method kMethods[] = {
     {"JOR De Saxce alpha 0.3", Kind::jor, ProxForm::de_saxce, RFactorStrategy::per_contact, 0.3},
     {"JOR global r alpha 0.3", Kind::jor, ProxForm::alart_curnier, RFactorStrategy::global, 0.3},
     {"APGD", Kind::apgd},
+    // Newton with its default linear solver (direct in local form, GMRES in body form) and with
+    // GMRES in both.
+    {"Newton", Kind::newton},
+    {"Newton GMRES", Kind::newton, ProxForm::alart_curnier, RFactorStrategy::per_contact, 1.0,
+     LinearSolver::gmres},
 };
 
 // Every stopping test.
@@ -136,6 +143,7 @@ SolverOptions with(const Method& m, SolverOptions o) {
   o.form = m.form;
   o.r_strategy = m.strategy;
   o.alpha = m.alpha;
+  o.newton.linear_solver = m.linear;
   return o;
 }
 
@@ -149,6 +157,8 @@ SolverResult solve(const Method& m, const ContactProblem& p, ContactSolution& s,
       return grbd::contact::solve_jor(p, s, o);
     case Kind::apgd:
       return grbd::contact::solve_apgd(p, s, o);
+    case Kind::newton:
+      return grbd::contact::solve_newton(p, s, o);
   }
   return {};
 }
@@ -163,12 +173,17 @@ SolverResult solve(const Method& m, const LocalProblem& p, std::vector<Vector3>&
       return grbd::contact::solve_jor(p, lambda, o);
     case Kind::apgd:
       return grbd::contact::solve_apgd(p, lambda, o);
+    case Kind::newton:
+      return grbd::contact::solve_newton(p, lambda, o);
   }
   return {};
 }
 
 const char* expected_name(Kind kind) {
-  return kind == Kind::sor ? "SOR" : kind == Kind::jor ? "JOR" : "APGD";
+  return kind == Kind::sor    ? "SOR"
+         : kind == Kind::jor  ? "JOR"
+         : kind == Kind::apgd ? "APGD"
+                              : "Newton";
 }
 
 std::vector<double> friction(const ContactProblem& problem) {
@@ -1040,6 +1055,9 @@ TEST(SolverInput, BodyFormRefusesBadProblemsOptionsAndGuesses) {
           case Kind::apgd:
             grbd::contact::solve_apgd(good, solution, o);
             break;
+          case Kind::newton:
+            grbd::contact::solve_newton(good, solution, o);
+            break;
         }
       });
       EXPECT_TRUE(contains(message, bad.named)) << "message: '" << message << "'";
@@ -1127,6 +1145,9 @@ TEST(SolverInput, LocalFormRefusesBadProblemsAndGuesses) {
             break;
           case Kind::apgd:
             grbd::contact::solve_apgd(good, lambda, o);
+            break;
+          case Kind::newton:
+            grbd::contact::solve_newton(good, lambda, o);
             break;
         }
       });

@@ -529,7 +529,8 @@ class Fclib(Scratch):
         self.assertEqual(result.returncode, 0, result.stderr)
         rows = [line.split() for line in result.stdout.splitlines()[1:]]
         solvers = [" ".join(r[1:-5]) for r in rows]
-        self.assertEqual(solvers, ["SOR-AC", "SOR-DS", "JOR", "APGD", "SOR-AC warm"])
+        self.assertEqual(solvers, ["SOR-AC", "SOR-DS", "JOR", "APGD", "Newton", "Newton-GMRES",
+                                   "SOR-AC warm"])
         for r in rows:
             self.assertEqual(r[0], "Spheres-i099-356-679")
             self.assertEqual(int(r[-5]), 356)          # contacts

@@ -183,8 +183,8 @@ TEST(SceneFile, OutOfRangeValuesNameTheKeyTheRangeAndTheValue) {
             "y, z], max = [x, y, z] } with min < max, found a table");
   EXPECT_EQ(
       error_of(replace(kMinimal, "[simulation]", "[solver]\nmethod = \"sore\"\n[simulation]")),
-      "scene.toml:2:10: solver.method: expected one of \"sor\", \"jor\", \"apgd\" (did you "
-      "mean \"sor\"?), found the string \"sore\"");
+      "scene.toml:2:10: solver.method: expected one of \"sor\", \"jor\", \"apgd\", \"newton\" "
+      "(did you mean \"sor\"?), found the string \"sore\"");
 }
 
 TEST(SceneFile, MaterialsAndPairsMustBeDeclared) {

@@ -40,11 +40,12 @@ std::vector<fs::path> fclib_files(const std::string& argument) {
 
 namespace {
 
+constexpr int kNewtonIterations = 200;  // Newton's cap in the bench (see fclib_bench())
+
 struct Run {
   std::string name;
   SolverOptions options;
-  bool jor = false;
-  bool apgd = false;
+  Method method = Method::sor;
   bool warm = false;
 };
 
@@ -52,7 +53,7 @@ struct Run {
 
 void fclib_bench(const std::vector<fs::path>& files, const FclibBenchOptions& options,
                  const std::function<void(const FclibBenchRow&)>& row) {
-  std::vector<Run> runs(4);
+  std::vector<Run> runs(6);
   for (Run& run : runs) {
     run.options.criterion = Criterion::natural_residual;
     run.options.abs_tol = 0.0;
@@ -64,11 +65,23 @@ void fclib_bench(const std::vector<fs::path>& files, const FclibBenchOptions& op
   runs[1].name = "SOR-DS";
   runs[1].options.form = ProxForm::de_saxce;
   runs[2].name = "JOR";
-  runs[2].jor = true;
+  runs[2].method = Method::jor;
   runs[2].options.alpha = 0.5;
   runs[2].options.r_strategy = RFactorStrategy::global;
   runs[3].name = "APGD";
-  runs[3].apgd = true;
+  runs[3].method = Method::apgd;
+  runs[4].name = "Newton";
+  runs[4].method = Method::newton;
+  runs[5].name = "Newton-GMRES";
+  runs[5].method = Method::newton;
+  runs[5].options.newton.linear_solver = LinearSolver::gmres;
+  // A Newton iteration is a linear solve: kNewtonIterations of them are as much work as tens of
+  // thousands of sweeps (GMRES's products with W cost a JOR iteration each).
+  for (Run& run : runs) {
+    if (run.method == Method::newton) {
+      run.options.max_iterations = std::min(options.max_iterations, kNewtonIterations);
+    }
+  }
 
   for (const fs::path& file : files) {
     const FclibInfo info = read_fclib_info(file);
@@ -83,14 +96,14 @@ void fclib_bench(const std::vector<fs::path>& files, const FclibBenchOptions& op
     for (const Run& run : these) {
       std::vector<Vector3> lambda;
       if (run.warm) lambda = *info.guess;
-      const SolverResult result = run.apgd  ? solve_apgd(problem, lambda, run.options)
-                                  : run.jor ? solve_jor(problem, lambda, run.options)
-                                            : solve_sor(problem, lambda, run.options);
+      ContactSolver solver(run.method, run.options);
+      const SolverResult result = solver.solve(problem, lambda);
       FclibBenchRow out;
       out.problem = file.stem().string();
       out.solver = run.name;
       out.contacts = problem.q.size();
       out.iterations = result.iterations;
+      out.linear_iterations = result.linear_iterations;
       out.relative_residual = result.relative_residual();
       out.scaled_residual = result.scaled_residual();
       out.seconds = result.seconds;

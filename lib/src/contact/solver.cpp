@@ -1,7 +1,8 @@
 /// \file
-/// \brief JOR, SOR and APGD for the body form and the local form of the contact problem.
+/// \brief JOR, SOR, APGD and semismooth Newton for the body form and the local form of the
+/// contact problem.
 ///
-/// One driver (iterate()) runs the loop of all three methods; each method is a policy with one
+/// One driver (iterate()) runs the loop of all four methods; each method is a policy with one
 /// iteration, the synchronisation of u for the hook, the acceptance of a met criterion (APGD's
 /// cone-offset check) and the end. The policies are written once, over a small "model" that
 /// knows how to evaluate the contact velocities ξ(Λ) of one form and how to do a Gauss–Seidel
@@ -13,6 +14,8 @@
 
 #include "grbd/contact/compact.hpp"
 
+#include <Eigen/SparseLU>
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -22,6 +25,7 @@
 #include <string>
 #include <utility>
 
+#include "grbd/contact/newton.hpp"
 #include "grbd/contact/prox.hpp"
 #include "grbd/core/checks.hpp"
 #include "grbd/core/error.hpp"
@@ -44,6 +48,17 @@ struct detail::SolverWorkspace {
   std::vector<Vector3> x_prev, y, xi_x, xi_prev, xi_y;  ///< APGD iterates and their ξ
   std::vector<double> s;              ///< APGD: cone offsets
   std::vector<Vector3> power_x, power_y;  ///< power iteration
+  /// Newton: Φ and the Jacobian blocks per contact, the preconditioner's blocks, the direction d
+  /// and W d, the trial point and its ξ, the merits of the last iterates, GMRES's buffers, the
+  /// assembled J and its factorization (direct)
+  std::vector<AlartCurnierJacobian> ac;
+  std::vector<Matrix3> precond;
+  std::vector<Vector3> d, wd, trial, trial_xi, x3, y3;
+  std::vector<double> merits, rhs, step;
+  GmresWorkspace gmres;
+  std::vector<Eigen::Triplet<double>> triplets;
+  Eigen::SparseMatrix<double> jacobian;
+  Eigen::SparseLU<Eigen::SparseMatrix<double>> lu;
 };
 
 namespace {
@@ -141,6 +156,26 @@ void validate_options(const SolverOptions& o, const char* solver) {
     default:
       refuse_enum("form", static_cast<int>(o.form), "alart_curnier, de_saxce");
   }
+  switch (o.newton.linear_solver) {
+    case LinearSolver::automatic:
+    case LinearSolver::direct:
+    case LinearSolver::gmres:
+      break;
+    default:
+      refuse_enum("newton.linear_solver", static_cast<int>(o.newton.linear_solver),
+                  "automatic, direct, gmres");
+  }
+  const NewtonOptions& n = o.newton;
+  if (n.krylov_restart < 1 || n.max_linear_iterations < 1 || n.line_search_memory < 1 ||
+      n.fallback_sweeps < 1) {
+    throw InvalidArgument(where() +
+                          "expected newton.krylov_restart, max_linear_iterations, "
+                          "line_search_memory and fallback_sweeps >= 1; found " +
+                          std::to_string(n.krylov_restart) + ", " +
+                          std::to_string(n.max_linear_iterations) + ", " +
+                          std::to_string(n.line_search_memory) + ", " +
+                          std::to_string(n.fallback_sweeps));
+  }
 }
 
 void validate_method(Method method, const char* where) {
@@ -148,10 +183,12 @@ void validate_method(Method method, const char* where) {
     case Method::sor:
     case Method::jor:
     case Method::apgd:
+    case Method::newton:
       return;
   }
   throw InvalidArgument(std::string(where) +
-                        ": expected the method to be one of sor, jor, apgd; found the value " +
+                        ": expected the method to be one of sor, jor, apgd, newton; found the "
+                        "value " +
                         std::to_string(static_cast<int>(method)));
 }
 
@@ -397,6 +434,8 @@ class LocalModel {
   }
   /// Residual and norms after the last (summarize_in_passes()).
   void summarize(SolverResult& result) { summarize_in_passes(*this, ws_, result); }
+  /// W itself, for Newton's direct linear solver.
+  const BlockSparseMatrix& block_matrix() const { return problem_.W; }
 
  private:
   const LocalProblem& problem_;
@@ -907,6 +946,283 @@ class ApgdPolicy {
   bool frictional_ = false;
 };
 
+/// Newton: one semismooth Newton step on the Alart–Curnier function per iteration (newton.hpp),
+/// with a non-monotone Armijo line search on ψ = ½‖Φ‖² and SOR sweeps where the step fails.
+template <class Model>
+class NewtonPolicy {
+ public:
+  NewtonPolicy(Model& model, const SolverOptions& options, Workspace& ws, SolverResult& result)
+      : model_(model),
+        options_(options),
+        velocity_watched_(options.criterion == Criterion::velocity_change),
+        ws_(ws),
+        result_(result) {
+    direct_ = options.newton.linear_solver == LinearSolver::direct;
+    if constexpr (requires { model.block_matrix(); }) {
+      direct_ = direct_ || options.newton.linear_solver == LinearSolver::automatic;
+    } else if (direct_) {
+      throw InvalidArgument("Newton: the direct linear solver needs W, which only the local form "
+                            "(FCLIB) has; use newton.linear_solver = gmres");
+    }
+    ws.merits.clear();
+    gather_mu(model, ws);  // for the residual of the projected percussions (accept())
+    if (direct_) pattern();
+  }
+
+  void iterate(int /*k*/) {
+    const std::size_t n = model_.size();
+    const std::span<Vector3> lambda = model_.lambda();
+    // Φ and J = A + B W at the iterate. Φ is divided by its largest component, `scale_`, for the
+    // merit and the linear system: percussions of 10²⁰⁰ or 10⁻²⁰⁰ would make ψ = ½‖Φ‖²
+    // overflow or underflow (the system is linear, so d follows from the scaled one).
+    model_.velocities(lambda, ws_.xi);
+    ws_.ac.resize(n);
+    scale_ = 0.0;
+    for (std::size_t i = 0; i < n; ++i) {
+      ws_.ac[i] = alart_curnier_jacobian(lambda[i], ws_.xi[i], ws_.r[i].r_N, ws_.r[i].r_T,
+                                         model_.mu(i));
+      scale_ = std::max(scale_, ws_.ac[i].phi.cwiseAbs().maxCoeff());
+    }
+    // Φ not finite: the problem's numbers overflow (a percussion beyond 10³⁰⁸). The prox sweeps
+    // then produce the non-finite iterate that the monitor reports as divergence.
+    if (!std::isfinite(scale_)) {
+      fall_back();
+      return;
+    }
+    if (scale_ == 0.0) return;           // Φ = 0: Λ solves the problem
+    double psi = 0.0;  // ψ / scale²
+    for (std::size_t i = 0; i < n; ++i) psi += 0.5 * (ws_.ac[i].phi / scale_).squaredNorm();
+    const double norm_phi = scale_ * std::sqrt(2.0 * psi);
+    if (phi0_ == 0.0) phi0_ = norm_phi;
+    // The merits of the last iterates, as log ψ, so that they compare whatever their scale.
+    if (static_cast<int>(ws_.merits.size()) >= options_.newton.line_search_memory) {
+      ws_.merits.erase(ws_.merits.begin());
+    }
+    ws_.merits.push_back(std::log(psi) + 2.0 * std::log(scale_));
+    double step = 0.0;
+    if (direction(norm_phi) && line_search(step)) {
+      // Levenberg–Marquardt's rule for the regularization: a full step lets it shrink, so that
+      // near a regular solution J itself takes over and the rate is quadratic.
+      if (step == 1.0) {
+        epsilon_ = std::max(epsilon_ * newton::kRegularizationDecrease, newton::kMinRegularization);
+      }
+    } else {
+      epsilon_ = std::min(epsilon_ * newton::kRegularizationIncrease, newton::kMaxRegularization);
+      fall_back();
+    }
+  }
+
+  void synchronize_for_hook() {
+    if (!velocity_watched_) model_.update_u();
+  }
+  /// The criterion is met. A Newton iterate satisfies the law only to within its residual, and
+  /// its percussions may lie outside the cones by as much; every solver returns percussions
+  /// inside them. So Λ is projected onto the cones, and the solve ends only if the projected Λ
+  /// still meets the criterion (the natural residual recomputed; for the other criteria, the
+  /// projection's change within their tolerance); otherwise Newton goes on from it.
+  bool accept(int /*k*/) {
+    const std::span<Vector3> lambda = model_.lambda();
+    ws_.trial.assign(lambda.begin(), lambda.end());
+    bool moved = false;
+    for (std::size_t i = 0; i < lambda.size(); ++i) {
+      lambda[i] = prox_cone(lambda[i], model_.mu(i));
+      moved = moved || lambda[i] != ws_.trial[i];
+    }
+    if (!moved) return true;
+    model_.touched();
+    model_.update_u();
+    model_.velocities(lambda, ws_.xi);
+    model_.record(ws_.xi, velocity_watched_);
+    const double residual = residual_norm(lambda, ws_.xi, ws_.mu);
+    if (options_.record_history && !result_.history.empty()) result_.history.back() = residual;
+    if (options_.criterion == Criterion::natural_residual) {
+      return residual <= options_.abs_tol + options_.rel_tol * result_.norm_c;
+    }
+    return has_converged(flat(std::span<const Vector3>(ws_.trial)),
+                         flat(std::span<const Vector3>(lambda)), options_.abs_tol,
+                         options_.rel_tol);
+  }
+  void finish() { model_.done(); }
+
+ private:
+  /// The direct solver's pattern: that of W (every diagonal block stored), analysed once.
+  void pattern() {
+    if constexpr (requires { model_.block_matrix(); }) {
+      const BlockSparseMatrix& W = model_.block_matrix();
+      const auto m = static_cast<Eigen::Index>(3 * W.size());
+      fill_triplets();
+      ws_.jacobian.resize(m, m);
+      ws_.jacobian.setFromTriplets(ws_.triplets.begin(), ws_.triplets.end());
+      ws_.lu.analyzePattern(ws_.jacobian);
+    }
+  }
+
+  /// J's entries as triplets, block (i, j) = B_i W_ij + δ_ij A_i (zeros before the first
+  /// iterate: the pattern is W's, whatever the values).
+  void fill_triplets() {
+    if constexpr (requires { model_.block_matrix(); }) {
+      const BlockSparseMatrix& W = model_.block_matrix();
+      const std::size_t n = W.size();
+      ws_.triplets.clear();
+      const bool values = ws_.ac.size() == n;
+      for (std::size_t i = 0; i < n; ++i) {
+        for (std::int64_t k = W.row_start[i]; k < W.row_start[i + 1]; ++k) {
+          const auto j = static_cast<std::size_t>(W.column[k]);
+          Matrix3 block = Matrix3::Zero();
+          if (values) {
+            block = ws_.ac[i].B * W.blocks[k];
+            if (j == i) block += ws_.ac[i].A + epsilon_ * Matrix3::Identity();
+          }
+          for (int a = 0; a < 3; ++a) {
+            for (int b = 0; b < 3; ++b) {
+              ws_.triplets.emplace_back(static_cast<Eigen::Index>(3 * i + a),
+                                        static_cast<Eigen::Index>(3 * j + b), block(a, b));
+            }
+          }
+        }
+      }
+    }
+  }
+
+  /// d with J d = −Φ; false when the linear solver fails (a singular J, a non-finite d).
+  bool direction(double norm_phi) {
+    const std::size_t n = model_.size();
+    ws_.d.resize(n);
+    if (direct_) {
+      fill_triplets();
+      ws_.jacobian.setFromTriplets(ws_.triplets.begin(), ws_.triplets.end());
+      ws_.lu.factorize(ws_.jacobian);
+      ++result_.linear_iterations;
+      if (ws_.lu.info() != Eigen::Success) return false;
+      Eigen::VectorXd b(static_cast<Eigen::Index>(3 * n));
+      for (std::size_t i = 0; i < n; ++i) {
+        b.segment<3>(static_cast<Eigen::Index>(3 * i)) = -ws_.ac[i].phi / scale_;
+      }
+      const Eigen::VectorXd x = ws_.lu.solve(b);
+      if (ws_.lu.info() != Eigen::Success || !x.allFinite()) return false;
+      for (std::size_t i = 0; i < n; ++i) {
+        ws_.d[i] = x.segment<3>(static_cast<Eigen::Index>(3 * i));  // d / scale
+      }
+      return true;
+    }
+    // GMRES on J = A + B W with the block-diagonal preconditioner (A_i + B_i W_ii)⁻¹ (the identity
+    // for a block that is singular).
+    ws_.precond.resize(n);
+    for (std::size_t i = 0; i < n; ++i) {
+      const Matrix3 M =
+          ws_.ac[i].A + ws_.ac[i].B * model_.delassus(i) + epsilon_ * Matrix3::Identity();
+      bool invertible = false;
+      double det = 0.0;
+      M.computeInverseAndDetWithCheck(ws_.precond[i], det, invertible);
+      if (!invertible || !ws_.precond[i].allFinite()) ws_.precond[i].setIdentity();
+    }
+    ws_.rhs.resize(3 * n);
+    ws_.step.resize(3 * n);
+    for (std::size_t i = 0; i < n; ++i) {
+      for (int a = 0; a < 3; ++a) ws_.rhs[3 * i + a] = -ws_.ac[i].phi(a) / scale_;
+    }
+    const Operator J(model_, ws_, epsilon_);
+    const double forcing = std::min(newton::kMaxForcing, norm_phi / phi0_);
+    const GmresResult g =
+        gmres(J, ws_.rhs, ws_.step, forcing * norm_phi / scale_, options_.newton.krylov_restart,
+              options_.newton.max_linear_iterations, ws_.gmres);
+    result_.linear_iterations += g.iterations;
+    for (std::size_t i = 0; i < n; ++i) {
+      ws_.d[i] = Vector3(ws_.step[3 * i], ws_.step[3 * i + 1], ws_.step[3 * i + 2]);  // d / scale
+    }
+    return all_finite(ws_.d);
+  }
+
+  /// The step Λ + t d with the largest t = 1, ½, ¼, … whose merit passes the (non-monotone)
+  /// Armijo test, t in `step`; false (Λ unchanged) when d is no descent direction or no t passes.
+  bool line_search(double& step) {
+    // In units of `scale_`: ws_.d holds d / scale, W d / scale follows, and the merits are
+    // ψ / scale². ξ is affine in Λ: ξ(Λ + t d) = ξ + t W d, no further product.
+    const std::size_t n = model_.size();
+    model_.apply_G(ws_.d, ws_.wd);
+    // ∇ψᵀd = Φᵀ J d, exact whatever the linear solver's accuracy.
+    double slope = 0.0;
+    for (std::size_t i = 0; i < n; ++i) {
+      slope += (ws_.ac[i].phi / scale_).dot(ws_.ac[i].A * ws_.d[i] + ws_.ac[i].B * ws_.wd[i]);
+    }
+    if (!(slope < 0.0)) return false;
+    const double reference = std::exp(*std::max_element(ws_.merits.begin(), ws_.merits.end()) -
+                                      2.0 * std::log(scale_));
+    const std::span<Vector3> lambda = model_.lambda();
+    ws_.trial.resize(n);
+    ws_.trial_xi.resize(n);
+    double t = 1.0;
+    for (int h = 0; h <= newton::kMaxHalvings; ++h, t *= 0.5) {
+      double merit = 0.0;
+      for (std::size_t i = 0; i < n; ++i) {
+        ws_.trial[i] = lambda[i] + (t * scale_) * ws_.d[i];
+        ws_.trial_xi[i] = ws_.xi[i] + (t * scale_) * ws_.wd[i];
+        merit += 0.5 * (alart_curnier_function(ws_.trial[i], ws_.trial_xi[i], ws_.r[i].r_N,
+                                               ws_.r[i].r_T, model_.mu(i)) /
+                        scale_)
+                           .squaredNorm();
+      }
+      if (merit <= reference + newton::kArmijo * t * slope) {
+        step = t;
+        std::copy(ws_.trial.begin(), ws_.trial.end(), lambda.begin());
+        model_.touched();
+        model_.record(ws_.trial_xi, velocity_watched_);
+        return true;
+      }
+    }
+    return false;
+  }
+
+  /// SOR sweeps in place of a failed Newton step.
+  void fall_back() {
+    ++result_.fallbacks;
+    // The sweeps move u with Λ: u must be in step with Λ first (the Newton steps changed Λ alone).
+    model_.update_u();
+    for (int s = 0; s < options_.newton.fallback_sweeps; ++s) {
+      model_.sor_sweep(ws_.r, ProxForm::alart_curnier);
+    }
+  }
+
+  /// y = J x = A x + B (W x) on flat vectors, and the block-diagonal preconditioner.
+  class Operator final : public LinearOperator {
+   public:
+    Operator(Model& model, Workspace& ws, double epsilon)
+        : model_(model), ws_(ws), epsilon_(epsilon) {}
+    void apply(std::span<const double> x, std::span<double> y) const override {
+      const std::size_t n = model_.size();
+      ws_.x3.resize(n);
+      for (std::size_t i = 0; i < n; ++i) ws_.x3[i] = Vector3(x[3 * i], x[3 * i + 1], x[3 * i + 2]);
+      model_.apply_G(ws_.x3, ws_.y3);
+      for (std::size_t i = 0; i < n; ++i) {
+        const Vector3 v =
+            ws_.ac[i].A * ws_.x3[i] + ws_.ac[i].B * ws_.y3[i] + epsilon_ * ws_.x3[i];
+        for (int a = 0; a < 3; ++a) y[3 * i + a] = v(a);
+      }
+    }
+    void precondition(std::span<const double> x, std::span<double> y) const override {
+      for (std::size_t i = 0; i < model_.size(); ++i) {
+        const Vector3 v = ws_.precond[i] * Vector3(x[3 * i], x[3 * i + 1], x[3 * i + 2]);
+        for (int a = 0; a < 3; ++a) y[3 * i + a] = v(a);
+      }
+    }
+
+   private:
+    Model& model_;
+    Workspace& ws_;
+    double epsilon_;
+  };
+
+  Model& model_;
+  const SolverOptions& options_;
+  bool velocity_watched_;
+  Workspace& ws_;
+  SolverResult& result_;
+  bool direct_ = false;
+  double phi0_ = 0.0;  // ‖Φ‖ at the first iterate, the scale of GMRES's forcing term
+  double epsilon_ = newton::kInitialRegularization;  // J + εI: Levenberg–Marquardt's ε
+  double scale_ = 1.0;  // the largest component of Φ at the iterate
+};
+
 /// The one loop of every method: before → iteration → hook → stopping test (local, then global;
 /// APGD's acceptance in between) → stop at max_iterations.
 template <class Model, class Policy>
@@ -963,7 +1279,7 @@ SolverResult run(Method method, Model& model, const SolverOptions& options,
                  const SolverHooks& hooks, Workspace& ws) {
   const auto start = Clock::now();
   SolverResult result;
-  result.solver = method_name(method);  // at most 4 characters: no allocation
+  result.solver = method_name(method);  // at most 6 characters, in the string itself: no allocation
   // Per-contact r-factors come with the model's first pass; the spectral ones need G applied.
   bool per_contact = false;
   if (method != Method::apgd) {
@@ -996,6 +1312,11 @@ SolverResult run(Method method, Model& model, const SolverOptions& options,
     }
     case Method::apgd: {
       ApgdPolicy<Model> policy(model, options, ws);
+      iterate(model, policy, monitor, options, hooks, result);
+      break;
+    }
+    case Method::newton: {
+      NewtonPolicy<Model> policy(model, options, ws, result);
       iterate(model, policy, monitor, options, hooks, result);
       break;
     }
@@ -1059,6 +1380,8 @@ std::string_view method_name(Method method) {
       return "JOR";
     case Method::apgd:
       return "APGD";
+    case Method::newton:
+      return "Newton";
   }
   validate_method(method, "method_name");
   return {};
@@ -1190,6 +1513,14 @@ SolverResult solve_jor(const LocalProblem& problem, std::vector<Vector3>& lambda
 SolverResult solve_apgd(const LocalProblem& problem, std::vector<Vector3>& lambda,
                         const SolverOptions& options) {
   return solve_local_once(Method::apgd, problem, lambda, options, "solve_apgd");
+}
+SolverResult solve_newton(const ContactProblem& problem, ContactSolution& solution,
+                          const SolverOptions& options) {
+  return solve_body_once(Method::newton, problem, solution, options, "solve_newton");
+}
+SolverResult solve_newton(const LocalProblem& problem, std::vector<Vector3>& lambda,
+                          const SolverOptions& options) {
+  return solve_local_once(Method::newton, problem, lambda, options, "solve_newton");
 }
 
 }  // namespace grbd::contact

@@ -544,7 +544,8 @@ void read_simulation(TableReader& t, Scene& scene) {
 
 void read_solver(TableReader& t, Scene& scene) {
   auto& s = scene.settings;
-  s.method = static_cast<contact::Method>(t.choice("method", {"sor", "jor", "apgd"}, 0));
+  s.method =
+      static_cast<contact::Method>(t.choice("method", {"sor", "jor", "apgd", "newton"}, 0));
   s.solver.max_iterations =
       static_cast<int>(t.integer("max_iterations", s.solver.max_iterations, 1, 100000000));
   s.solver.min_iterations = static_cast<int>(

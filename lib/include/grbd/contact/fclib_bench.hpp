@@ -22,9 +22,11 @@ struct FclibBenchOptions {
 /// One solver on one problem.
 struct FclibBenchRow {
   std::string problem;           ///< the file's stem
-  std::string solver;            ///< SOR-AC, SOR-DS, JOR, APGD or "SOR-AC warm"
+  /// SOR-AC, SOR-DS, JOR, APGD, Newton (sparse LU), Newton-GMRES or "SOR-AC warm"
+  std::string solver;
   std::size_t contacts = 0;      ///< n
   int iterations = 0;            ///< iterations done
+  int linear_iterations = 0;     ///< Newton: factorizations (LU) or products with J (GMRES)
   double relative_residual = 0;  ///< ‖F‖/‖q‖
   double scaled_residual = 0;    ///< ‖F‖/max(‖q‖, ‖λ‖, ‖ξ‖)
   double seconds = 0;            ///< wall time of the solve
@@ -38,8 +40,9 @@ struct FclibBenchRow {
 std::vector<std::filesystem::path> fclib_files(const std::string& argument);
 
 /// Solves every problem of `files` with SOR (Alart–Curnier and De Saxcé prox), JOR (α = 0.5,
-/// one global r) and APGD, and SOR warm from the file's guess where it holds one; calls `row`
-/// after each solve. Throws what the FCLIB reader throws for a file it cannot read.
+/// one global r), APGD, Newton with the sparse LU and Newton with GMRES (at most 200 Newton
+/// iterations, or max_iterations if fewer), and SOR warm from the file's guess where it holds one;
+/// calls `row` after each solve. Throws what the FCLIB reader throws for a file it cannot read.
 void fclib_bench(const std::vector<std::filesystem::path>& files, const FclibBenchOptions& options,
                  const std::function<void(const FclibBenchRow&)>& row);
 

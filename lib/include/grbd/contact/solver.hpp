@@ -1,11 +1,12 @@
 #pragma once
 /// \file
 /// \brief Iterative solvers of the contact problem (chapter 5): projected Jacobi (JOR) and
-/// Gauss–Seidel (SOR) prox iterations with r-factor strategies and convergence criteria, and an
-/// accelerated projected gradient method with adaptive restart (APGD), for the body form
-/// (ContactProblem) and the local form (LocalProblem) of the problem.
+/// Gauss–Seidel (SOR) prox iterations with r-factor strategies and convergence criteria, an
+/// accelerated projected gradient method with adaptive restart (APGD), and a semismooth Newton
+/// method on the Alart–Curnier function (newton.hpp), for the body form (ContactProblem) and the
+/// local form (LocalProblem) of the problem.
 ///
-/// The three methods share one driver: every iteration is "remember what the stopping test
+/// The four methods share one driver: every iteration is "remember what the stopping test
 /// compares; one iteration of the method; the hook SolverHooks::after_iteration; the stopping
 /// test, turned into a global verdict by SolverHooks::global_status; stop at max_iterations".
 /// ContactSolver keeps the buffers of that loop between solves (a time stepper calls it once per
@@ -48,15 +49,16 @@ bool has_converged(std::span<const double> x_old, std::span<const double> x, dou
                    double rel_tol);
 // [converged declaration]
 
-/// The three iterative methods.
+/// The iterative methods.
 enum class Method {
-  sor,   ///< projected Gauss–Seidel (successive over-relaxation)
-  jor,   ///< projected Jacobi (Jacobi over-relaxation)
-  apgd,  ///< accelerated projected gradient descent with adaptive restart
+  sor,     ///< projected Gauss–Seidel (successive over-relaxation)
+  jor,     ///< projected Jacobi (Jacobi over-relaxation)
+  apgd,    ///< accelerated projected gradient descent with adaptive restart
+  newton,  ///< semismooth Newton on the Alart–Curnier function with a line search
 };
 
-/// "SOR", "JOR" or "APGD" (SolverResult::solver); throws InvalidArgument for a value outside the
-/// enumerators.
+/// "SOR", "JOR", "APGD" or "Newton" (SolverResult::solver); throws InvalidArgument for a value
+/// outside the enumerators.
 std::string_view method_name(Method method);
 
 /// How a solver picks the r-factors.
@@ -120,6 +122,34 @@ inline constexpr double kShrink = 0.9;
 inline constexpr double kDecreaseSlack = 1e-12;
 }  // namespace apgd
 
+/// How the Newton method solves its linear system J d = −Φ in each iteration.
+enum class LinearSolver {
+  /// direct in the local form (FCLIB), where W is at hand; GMRES in the body and compact forms
+  automatic,
+  /// a sparse LU factorization of J = A + B W assembled from W's blocks (Eigen's SparseLU, the
+  /// pattern analysed once per solve): local form only
+  direct,
+  /// restarted GMRES with J applied as A x + B (W x), W never formed, and the block-diagonal
+  /// preconditioner (A_i + B_i W_ii)⁻¹; every form
+  gmres,
+};
+
+// [newton options]
+/// The Newton method's own options (SolverOptions::newton).
+struct NewtonOptions {
+  LinearSolver linear_solver = LinearSolver::automatic;  ///< how J d = −Φ is solved
+  int krylov_restart = 30;          ///< GMRES: Krylov vectors before a restart, >= 1
+  int max_linear_iterations = 300;  ///< GMRES: products with J per Newton iteration at most, >= 1
+  /// The line search compares with the largest merit ψ of the last this many iterates (a
+  /// non-monotone Armijo rule, Grippo, Lampariello and Lucidi 1986); 1, the default, is the
+  /// monotone rule.
+  int line_search_memory = 1;
+  /// When the Newton direction fails (no descent, no step passes the line search, a singular J):
+  /// this many SOR sweeps (Alart–Curnier form, SOR's r-factors) instead, >= 1.
+  int fallback_sweeps = 5;
+};
+// [newton options]
+
 /// What a solver watches to stop.
 enum class Criterion {
   percussion_change,  ///< has_converged on all λ between two iterations
@@ -142,12 +172,13 @@ struct SolverOptions {
   double alpha = 1.0;               ///< relaxation α ∈ (0, 2) of the r-factors
   ProxForm form = ProxForm::alart_curnier;  ///< prox update of JOR and SOR
   bool record_history = false;      ///< store the natural-map residual after every iteration
+  NewtonOptions newton;             ///< Method::newton only
 };
 
 /// What a solver did. Non-convergence is not an exception: `converged` is false and the numbers
 /// say how far it got (describe() words it).
 struct SolverResult {
-  std::string solver;            ///< method_name(): "SOR", "JOR" or "APGD"
+  std::string solver;            ///< method_name(): "SOR", "JOR", "APGD" or "Newton"
   bool converged = false;        ///< the criterion was met within max_iterations
   /// an iterate or the residual was not finite (∞ or NaN): the solver stopped at once; never
   /// together with `converged`
@@ -157,6 +188,9 @@ struct SolverResult {
   double norm_c = 0.0;           ///< ‖c‖, the free contact velocities (FCLIB: ‖q‖)
   double norm_max = 0.0;         ///< max(‖c‖, ‖λ‖, ‖ξ‖) of the returned λ
   double seconds = 0.0;          ///< wall time of the solve
+  /// Newton: the linear solver's work, products with J (GMRES) or factorizations (direct)
+  int linear_iterations = 0;
+  int fallbacks = 0;             ///< Newton: iterations that fell back to SOR sweeps
   std::vector<double> history;   ///< ‖F‖ after each iteration, when record_history
   /// ‖F‖/‖c‖ (FCLIB's classic measure); ‖F‖ when ‖c‖ = 0.
   double relative_residual() const { return norm_c > 0.0 ? residual / norm_c : residual; }
@@ -237,7 +271,9 @@ struct SolverWorkspace;  ///< the buffers of ContactSolver (solver.cpp)
 /// A reusable solver: one method, its options and hooks, and a workspace that keeps its
 /// capacity. After the first solve, a solve of a problem of the same or smaller size (contacts
 /// and bodies) allocates nothing on the heap, unless options().record_history asks for the
-/// history, or the caller's ContactSolution must grow. Movable, not copyable.
+/// history, or the caller's ContactSolution must grow, or Newton factorizes J (its direct linear
+/// solver: Eigen's sparse LU allocates in every factorization; Newton with GMRES does not).
+/// Movable, not copyable.
 class ContactSolver {
  public:
   /// Validates the options once (InvalidArgument, as the free functions do).
@@ -303,6 +339,12 @@ SolverResult solve_jor(const ContactProblem& problem, ContactSolution& solution,
 /// numbers are the constants of namespace apgd. r_strategy does not apply.
 SolverResult solve_apgd(const ContactProblem& problem, ContactSolution& solution,
                         const SolverOptions& options = {});
+/// Semismooth Newton on the Alart–Curnier function Φ (newton.hpp) with SOR's r-factors as ρ:
+/// each iteration solves J d = −Φ (options.newton.linear_solver; the body form with GMRES, W
+/// never formed) and takes the step t d with the largest t = 1, ½, ¼, … that passes a
+/// non-monotone Armijo test on ψ = ½‖Φ‖²; where the direction fails, SOR sweeps instead.
+SolverResult solve_newton(const ContactProblem& problem, ContactSolution& solution,
+                          const SolverOptions& options = {});
 ///@}
 
 /// \name Local-form solvers (FCLIB)
@@ -318,6 +360,9 @@ SolverResult solve_jor(const LocalProblem& problem, std::vector<Vector3>& lambda
 /// Accelerated projected gradient with adaptive restart.
 SolverResult solve_apgd(const LocalProblem& problem, std::vector<Vector3>& lambda,
                         const SolverOptions& options = {});
+/// Semismooth Newton on the Alart–Curnier function, by default with a sparse LU of J.
+SolverResult solve_newton(const LocalProblem& problem, std::vector<Vector3>& lambda,
+                          const SolverOptions& options = {});
 ///@}
 
 }  // namespace grbd::contact
