@@ -1,6 +1,6 @@
 # Figure ch08_chute_steps (chapter 8): the solver's work through the run of the reference chute —
-# contacts, sweeps of the SOR solver (capped at the scene's max_iterations) and the largest
-# penetration per step, against the time after the release.
+# contacts, sweeps of the SOR solver (capped at the scene's max_iterations) and the penetration
+# per step (the largest and the mean over the contacts), against the time after the release.
 #
 # Data: steps.csv and values.txt from the demo ch08_chute (chute_flow.cpp). Run as
 #   gnuplot -e "datadir='<data directory>'; outfile='<figure>.svg'" chute_steps.gp
@@ -29,7 +29,11 @@ plot steps using ($1 - release):2 skip 1 every 5 with lines lw 1.5 lc rgb "#0072
 set ylabel "sweeps"
 set yrange [0:*]
 plot steps using ($1 - release):3 skip 1 every 5 with lines lw 1 lc rgb "#e69f00" notitle
-set ylabel "largest penetration [mm]"
+set ylabel "penetration [mm]"
 set xlabel "time after the release [s]"
-plot steps using ($1 - release):6 skip 1 every 5 with lines lw 1 lc rgb "#cc0000" notitle
+set logscale y
+set format y "10^{%L}"
+set yrange [1e-4:1]
+plot steps using ($1 - release):6 skip 1 every 5 with lines lw 1 lc rgb "#cc0000" title "largest", \
+     steps using ($1 - release):7 skip 1 every 5 with lines lw 1 lc rgb "#0072b2" title "mean over the contacts"
 unset multiplot

@@ -52,7 +52,7 @@ using grbd::contact::SolverHooks;
 using grbd::contact::SolverOptions;
 using grbd::contact::SolverResult;
 
-constexpr Method kAllMethods[] = {Method::sor, Method::jor, Method::apgd};
+constexpr Method kAllMethods[] = {Method::sor, Method::jor, Method::apgd, Method::newton};
 constexpr Criterion kAllCriteria[] = {Criterion::percussion_change, Criterion::velocity_change,
                                       Criterion::natural_residual};
 
@@ -81,6 +81,9 @@ SolverOptions quick(Method m, Criterion criterion = Criterion::percussion_change
   o.abs_tol = 0.0;
   o.max_iterations = 5000;
   if (m == Method::jor) o.alpha = 0.5;  // spectral r (automatic): any α in (0, 2) is safe
+  // Newton's iterates go on moving at the rounding level of the velocities that are zero at the
+  // solution (sticking contacts): a change criterion needs an absolute tolerance with it.
+  if (m == Method::newton) o.abs_tol = 1e-14;
   return o;
 }
 

@@ -772,6 +772,7 @@ TEST(Stepper, ReportsEnergiesPenetrationAndStageTimes) {
   EXPECT_EQ(r.contacts, 1u);
   EXPECT_TRUE(r.converged);
   EXPECT_NEAR(r.max_penetration, 0.01, 1e-12);
+  EXPECT_NEAR(r.mean_penetration, 0.01, 1e-12);  // one contact: the mean is the largest
   EXPECT_NEAR(r.potential_energy, system.inertia()[0].m * kG * system.states()[0].q.z(), 1e-12);
   EXPECT_GE(r.seconds.total, r.seconds.solve);
   EXPECT_GE(r.seconds.solve, 0.0);

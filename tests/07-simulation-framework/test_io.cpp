@@ -161,6 +161,7 @@ TEST_F(Folder, StepsAndContactsReadBackAsTheRunHadThem) {
     EXPECT_EQ(steps[k].converged, reports[k].converged);
     EXPECT_EQ(steps[k].residual, reports[k].residual);
     EXPECT_EQ(steps[k].max_penetration, reports[k].max_penetration);
+    EXPECT_EQ(steps[k].mean_penetration, reports[k].mean_penetration);
     EXPECT_EQ(steps[k].kinetic_energy, reports[k].kinetic_energy);
   }
   auto expected = part.contacts;

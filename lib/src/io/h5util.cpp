@@ -65,6 +65,7 @@ Handle step_row_type() {
   H5Tinsert(type.get(), "kinetic_energy", HOFFSET(StepRow, kinetic_energy), H5T_NATIVE_DOUBLE);
   H5Tinsert(type.get(), "potential_energy", HOFFSET(StepRow, potential_energy), H5T_NATIVE_DOUBLE);
   H5Tinsert(type.get(), "max_penetration", HOFFSET(StepRow, max_penetration), H5T_NATIVE_DOUBLE);
+  H5Tinsert(type.get(), "mean_penetration", HOFFSET(StepRow, mean_penetration), H5T_NATIVE_DOUBLE);
   H5Tinsert(type.get(), "seconds_midpoint", HOFFSET(StepRow, seconds_midpoint), H5T_NATIVE_DOUBLE);
   H5Tinsert(type.get(), "seconds_detection", HOFFSET(StepRow, seconds_detection),
             H5T_NATIVE_DOUBLE);

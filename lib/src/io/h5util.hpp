@@ -56,6 +56,7 @@ struct StepRow {
   double kinetic_energy;
   double potential_energy;
   double max_penetration;
+  double mean_penetration;
   double seconds_midpoint;
   double seconds_detection;
   double seconds_assembly;

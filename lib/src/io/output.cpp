@@ -365,7 +365,7 @@ void OutputFile::create(const scene::Scene& scene) {
   h5::write_attribute(o.steps.get(), "units",
                       std::string("step: 1; t: s; bodies, contacts, warm_started, iterations: 1; "
                                   "converged: 0 or 1; residual: natural map (chapter 5); "
-                                  "kinetic_energy, potential_energy: J; max_penetration: m; "
+                                  "kinetic_energy, potential_energy: J; max_penetration, mean_penetration: m; "
                                   "seconds_*: s of wall time"),
                       o.file);
   const StaticSurface surface = write_static(root, scene, o.file);
@@ -480,6 +480,7 @@ void OutputFile::add_step(const timestep::StepReport& report, std::size_t bodies
   row.kinetic_energy = report.kinetic_energy;
   row.potential_energy = report.potential_energy;
   row.max_penetration = report.max_penetration;
+  row.mean_penetration = report.mean_penetration;
   row.seconds_midpoint = report.seconds.midpoint;
   row.seconds_detection = report.seconds.detection;
   row.seconds_assembly = report.seconds.assembly;
@@ -901,7 +902,8 @@ std::vector<StepInfo> step_infos(hid_t root, const std::string& file) {
   steps.reserve(rows.size());
   for (const h5::StepRow& row : rows) {
     steps.push_back({row.step, row.t, row.bodies, row.contacts, row.iterations, row.converged != 0,
-                     row.residual, row.max_penetration, row.kinetic_energy, row.seconds_total});
+                     row.residual, row.max_penetration, row.mean_penetration, row.kinetic_energy,
+                     row.seconds_total});
   }
   return steps;
 }

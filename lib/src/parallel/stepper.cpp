@@ -237,9 +237,11 @@ void ParallelStepper::average_split_velocities(std::span<Vector6> u) {
 // [average]
 
 void ParallelStepper::reduce(timestep::StepReport& report) const {
+  // The mean penetration as a sum over this process's contacts, each contact on one process.
   std::vector<double> sums{static_cast<double>(report.contacts),
                            static_cast<double>(report.warm_started), report.kinetic_energy,
-                           report.potential_energy};
+                           report.potential_energy,
+                           report.mean_penetration * static_cast<double>(report.contacts)};
   comm_.sum(sums);
   std::vector<double> maxima{static_cast<double>(report.iterations), report.residual,
                              report.max_penetration, report.converged ? 0.0 : 1.0};
@@ -248,6 +250,7 @@ void ParallelStepper::reduce(timestep::StepReport& report) const {
   report.warm_started = static_cast<std::size_t>(sums[1]);
   report.kinetic_energy = sums[2];
   report.potential_energy = sums[3];
+  report.mean_penetration = report.contacts > 0 ? sums[4] / static_cast<double>(report.contacts) : 0.0;
   // Without a contact on any process the solve had nothing to do; the processes still swept once
   // together (each must learn that the others have no contacts): the serial count is 0.
   report.iterations = report.contacts == 0 ? 0 : static_cast<int>(maxima[0]);

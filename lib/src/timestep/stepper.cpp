@@ -442,8 +442,13 @@ void MoreauStepper::finish(StepReport& report) {
   if (!finite || !std::isfinite(report.kinetic_energy) || !std::isfinite(report.potential_energy)) {
     require_finite(report, "");
   }
+  double penetration = 0.0;
   for (const DetectedContact& c : contacts_) {
     report.max_penetration = std::max(report.max_penetration, -c.geometry.g_N);
+    penetration += std::max(0.0, -c.geometry.g_N);
+  }
+  if (!contacts_.empty()) {
+    report.mean_penetration = penetration / static_cast<double>(contacts_.size());
   }
   t_ += settings_.dt;
   ++steps_;

@@ -342,7 +342,9 @@ SolverResult solve_apgd(const ContactProblem& problem, ContactSolution& solution
 /// Semismooth Newton on the Alart–Curnier function Φ (newton.hpp) with SOR's r-factors as ρ:
 /// each iteration solves J d = −Φ (options.newton.linear_solver; the body form with GMRES, W
 /// never formed) and takes the step t d with the largest t = 1, ½, ¼, … that passes a
-/// non-monotone Armijo test on ψ = ½‖Φ‖²; where the direction fails, SOR sweeps instead.
+/// non-monotone Armijo test on ψ = ½‖Φ‖²; where the direction fails, SOR sweeps instead. Its
+/// iterates go on moving at the rounding level of velocities that are zero at the solution, so
+/// the change criteria (percussion_change, velocity_change) need abs_tol > 0 with it.
 SolverResult solve_newton(const ContactProblem& problem, ContactSolution& solution,
                           const SolverOptions& options = {});
 ///@}

@@ -56,7 +56,7 @@ struct OutputPosition {
 };
 
 /// The format version written to and required from output files.
-inline constexpr std::uint64_t kOutputFormatVersion = 1;
+inline constexpr std::uint64_t kOutputFormatVersion = 2;
 
 /// What identifies the run a restart continues: the output it reopens must be that run's.
 struct RunIdentity {
@@ -249,6 +249,7 @@ struct StepInfo {
   bool converged = false;        ///< whether it reached its tolerance
   double residual = 0.0;         ///< the solver's last residual
   double max_penetration = 0.0;  ///< max(0, −g_N) over the contacts at the midpoint [m]
+  double mean_penetration = 0.0;  ///< its mean over the contacts [m] (0 without contacts)
   double kinetic_energy = 0.0;   ///< of the bodies at the end of the step [J]
   double seconds = 0.0;          ///< wall time of the step [s]
 };

@@ -96,6 +96,8 @@ struct StepReport {
   double kinetic_energy = 0.0;    ///< of the owned bodies at the end of the step [J]
   double potential_energy = 0.0;  ///< −Σ m I_gᵀ I_r_S over the owned bodies, end of step [J]
   double max_penetration = 0.0;   ///< max(0, −g_N) over the contacts at the midpoint [m]
+  /// the mean of max(0, −g_N) over the contacts at the midpoint [m] (0 without contacts)
+  double mean_penetration = 0.0;
   StepTimes seconds;              ///< stage timings
 };
 
