@@ -159,20 +159,20 @@ Profile layer_profile(const std::filesystem::path& output, const grbd::scene::Sc
                       std::to_string(summary.records) + ")");
   }
   const auto& box = scene.domain.box;
-  Profile p{grbd::parallel::DepthProfile(0.0, 1.0, 1, 1.0, 1.0)};
-  p.area = (box.max.x() - box.min.x()) * (box.max.y() - box.min.y());
-  double fixed_radius = 0.0;
+  const double area = (box.max.x() - box.min.x()) * (box.max.y() - box.min.y());
+  double fixed_radius = 0.0, density = 0.0, diameter = 0.0;
   for (const auto& g : scene.groups) {
     if (g.fixed) {
       fixed_radius = std::max(fixed_radius, g.radius.max());
     } else {
-      p.density = *g.density;
-      p.diameter = g.radius.min() + g.radius.max();  // the mean of a uniform distribution, twice
+      density = *g.density;
+      diameter = g.radius.min() + g.radius.max();  // the mean of a uniform distribution, twice
     }
   }
-  p.bin = 0.5 * p.diameter;
-  p.bins = static_cast<std::size_t>(std::ceil(0.1 / p.bin));
-  p.depth = grbd::parallel::DepthProfile(0.0, p.bin, p.bins, p.area, p.density);
+  const double bin = 0.5 * diameter;
+  const auto bins = static_cast<std::size_t>(std::ceil(0.1 / bin));
+  Profile p{grbd::parallel::DepthProfile(0.0, bin, bins, area, density), diameter, density, bin,
+            bins, area};
   std::vector<grbd::Vector3> centres, velocities;
   double base = -1e300;
   for (std::uint64_t k = first_record; k < summary.records; ++k) {

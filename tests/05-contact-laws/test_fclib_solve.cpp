@@ -29,7 +29,7 @@ using grbd::contact::SolverResult;
 using grbd::test::norm;
 using grbd::test::to_tolerance;
 
-std::filesystem::path data_file(const std::string& name) { return grbd::test::fclib_file(name); }
+using grbd::test::fclib_file;
 
 /// Solves, then checks the result independently: the residual recomputed from ξ = Wλ + q, the
 /// percussions inside the cone, and the Siconos bound. `solver` is "SOR" or "APGD". Returns ξ.
@@ -65,7 +65,7 @@ void expect_same_velocities(const std::vector<Vector3>& a, const std::vector<Vec
 void expect_siconos_residual_with_sor_and_apgd(const std::string& file, std::size_t n,
                                                double siconos_residual, int max_iterations,
                                                double agreement) {
-  const LocalProblem problem = grbd::contact::read_fclib_as_local(data_file(file));
+  const LocalProblem problem = grbd::contact::read_fclib_as_local(fclib_file(file));
   ASSERT_EQ(problem.q.size(), n);
   const auto xi_sor = solve_and_check(problem, "SOR", siconos_residual, max_iterations);
   const auto xi_apgd = solve_and_check(problem, "APGD", siconos_residual, max_iterations);
@@ -87,7 +87,7 @@ TEST(FclibSolve, Spheres356GlobalReachesSiconosResidualWithSorAndApgd) {
 
 TEST(FclibSolve, NonConvergenceIsReportedNotHidden) {
   const LocalProblem problem =
-      grbd::contact::read_fclib_as_local(data_file("Capsules-i125-1213.hdf5"));
+      grbd::contact::read_fclib_as_local(fclib_file("Capsules-i125-1213.hdf5"));
   std::vector<Vector3> lambda;
   const SolverResult result = grbd::contact::solve_sor(problem, lambda, to_tolerance(1e-10, 50));
   EXPECT_FALSE(result.converged);

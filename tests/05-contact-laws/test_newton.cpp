@@ -39,7 +39,7 @@ using grbd::contact::SolverResult;
 using grbd::test::norm;
 using grbd::test::to_tolerance;
 
-std::filesystem::path data_file(const std::string& name) { return grbd::test::fclib_file(name); }
+using grbd::test::fclib_file;
 
 TEST(Exercise5_9, ProxNonnegativeJacobianIsTheSlopeOfMax) {
   EXPECT_EQ(grbd::contact::prox_nonnegative_jacobian(2.5), 1.0);
@@ -264,7 +264,7 @@ TEST(NewtonFclib, EveryProblemSolvedTo1e10) {
   for (const char* file : {"LMGC_100_PR_PerioBox-i00361-60-03000.hdf5", "Capsules-i125-1213.hdf5",
                            "Spheres-i099-356-679.hdf5"}) {
     SCOPED_TRACE(file);
-    const LocalProblem problem = grbd::contact::read_fclib_as_local(data_file(file));
+    const LocalProblem problem = grbd::contact::read_fclib_as_local(fclib_file(file));
     std::vector<Vector3> lambda;
     const SolverResult result = grbd::contact::solve_newton(problem, lambda, to_tolerance(1e-10, 200));
     EXPECT_TRUE(result.converged) << grbd::contact::describe(result);

@@ -30,6 +30,7 @@
 #include "grbd/contact/solver.hpp"
 #include "grbd/core/error.hpp"
 #include "grbd_test/contact_problems.hpp"
+#include "grbd_test/fclib_data.hpp"
 #include "grbd_test/random.hpp"
 #include "sphere_pile.hpp"
 
@@ -130,9 +131,7 @@ template <class V>
   return ::testing::AssertionSuccess();
 }
 
-std::filesystem::path fclib_file(const std::string& file) {
-  return std::filesystem::path(GRBD_FCLIB_DATA_DIR) / file;
-}
+using grbd::test::fclib_file;
 
 // ---------------------------------------------------------------------------------------------
 // SOR through the driver is the hand-made loop of sor_sweep()
