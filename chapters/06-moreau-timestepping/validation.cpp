@@ -477,44 +477,97 @@ struct PileRun {
   std::vector<StepReport> reports;
   std::size_t spheres = 0;
   double seconds = 0.0;
+  double solve_seconds = 0.0;  // the contact solver's share
 };
 
-PileRun settle(bool warm_start, int n, double dt, double t_end, double r) {
+/// The pile's solvers: SOR warm- and cold-started, and chapter 5's Newton and hybrid, warm.
+enum class PileSolver { sor_warm, sor_cold, newton_warm, hybrid_warm };
+
+/// Newton's iterations per step at most: each costs up to 300 GMRES products, so the prox
+/// solvers' 1000 would be thousands of sweeps' work.
+constexpr int kPileNewtonIterations = 50;
+/// The hybrid's SOR sweeps per step at most before Newton takes over.
+constexpr int kPileHybridSweeps = 1000;
+/// Newton and the hybrid in the time stepper cost 20-35 times SOR's time per step here: they run
+/// kLateSteps steps from the warm SOR run's state after kLateStart steps (t = 0.2 s, most
+/// spheres in contact), side by side with SOR from the same state.
+constexpr std::uint64_t kLateStart = 1000;
+constexpr int kLateSteps = 100;
+
+/// The settings of a pile run: the default solver (SOR, its default tolerance and 1000
+/// iterations), or Newton and the hybrid with the same criterion and tolerances.
+StepSettings pile_settings(PileSolver solver, double dt) {
+  StepSettings settings;
+  settings.dt = dt;
+  settings.warm_start = solver != PileSolver::sor_cold;
+  if (solver == PileSolver::newton_warm || solver == PileSolver::hybrid_warm) {
+    settings.method = contact::Method::newton;
+    settings.solver.max_iterations = kPileNewtonIterations;
+  }
+  if (solver == PileSolver::hybrid_warm) {
+    settings.solver.newton.hybrid_sweeps = kPileHybridSweeps;
+    settings.solver.max_iterations = 1 + kPileNewtonIterations;  // the SOR phase is one
+  }
+  settings.reorder_interval = 50;
+  return settings;
+}
+
+/// The pile's bodies, box and material, and (a snapshot) its stepper's clock and warm starts.
+struct PileState {
+  BodySystem system;
+  StaticGeometry statics;
+  MaterialTable materials;
+  timestep::WarmStartTable warm;
+  double t = 0.0;
+  std::uint64_t steps = 0;
+};
+
+PileState pile_state(int n, double r) {
   const double spacing = 2.4 * r;
   const double L = n * spacing + 0.4 * r;
-  BodySystem system;
+  PileState state;
   std::mt19937_64 rng(6);
   std::uniform_real_distribution<double> jitter(-0.1 * r, 0.1 * r);
   GlobalId id = 1;
   for (int k = 0; k < n; ++k) {
     for (int j = 0; j < n; ++j) {
       for (int i = 0; i < n; ++i) {
-        system.add(demo::sphere_body(id++, r,
+        state.system.add(demo::sphere_body(id++, r,
                           Vector3(1.2 * r + spacing * i + jitter(rng),
                                   1.2 * r + spacing * j + jitter(rng), 1.1 * r + spacing * k)));
       }
     }
   }
-  StaticGeometry statics;
-  statics.add(half_space(0, Vector3::UnitZ(), 0.0));
-  statics.add(half_space(1, Vector3::UnitX(), 0.0));  // the solid x ≤ 0
-  statics.add(half_space(2, -Vector3::UnitX(), -L));  // x ≥ L
-  statics.add(half_space(3, Vector3::UnitY(), 0.0));
-  statics.add(half_space(4, -Vector3::UnitY(), -L));
-  MaterialTable materials;
-  const timestep::MaterialId glass = materials.add("glass");
-  materials.set_pair(glass, glass, {0.5, 0.0, 0.0});
-  StepSettings settings;  // the default solver: SOR, its default tolerance and 1000 iterations
-  settings.dt = dt;
-  settings.warm_start = warm_start;
-  settings.reorder_interval = 50;
-  MoreauStepper stepper(system, statics, materials, settings);
+  state.statics.add(half_space(0, Vector3::UnitZ(), 0.0));
+  state.statics.add(half_space(1, Vector3::UnitX(), 0.0));  // the solid x ≤ 0
+  state.statics.add(half_space(2, -Vector3::UnitX(), -L));  // x ≥ L
+  state.statics.add(half_space(3, Vector3::UnitY(), 0.0));
+  state.statics.add(half_space(4, -Vector3::UnitY(), -L));
+  const timestep::MaterialId glass = state.materials.add("glass");
+  state.materials.set_pair(glass, glass, {0.5, 0.0, 0.0});
+  return state;
+}
+
+/// Runs `state` with `solver` until t_end; keeps a snapshot after `snapshot_step` steps when
+/// `snapshot` is given.
+PileRun settle(PileState& state, PileSolver solver, double dt, double t_end,
+               PileState* snapshot = nullptr, std::uint64_t snapshot_step = 0) {
+  MoreauStepper stepper(state.system, state.statics, state.materials, pile_settings(solver, dt));
+  stepper.warm_starts() = state.warm;
+  stepper.set_clock(state.t, state.steps);
   PileRun run;
-  run.spheres = system.size();
+  run.spheres = state.system.size();
   while (stepper.time() < t_end - 0.5 * dt) {
     stepper.reorder_if_due();
     run.reports.push_back(stepper.step());
     run.seconds += run.reports.back().seconds.total;
+    run.solve_seconds += run.reports.back().seconds.solve;
+    if (snapshot != nullptr && stepper.steps() == snapshot_step) {
+      *snapshot = state;
+      snapshot->warm = stepper.warm_starts();
+      snapshot->t = stepper.time();
+      snapshot->steps = stepper.steps();
+    }
   }
   return run;
 }
@@ -525,8 +578,19 @@ void pile(const std::filesystem::path& dir) {
   const double r = 1e-3;
   const double dt = 2e-4;
   const double t_end = 0.3;
-  const PileRun warm = settle(true, n, dt, t_end, r);
-  const PileRun cold = settle(false, n, dt, t_end, r);
+  PileState late;  // the warm run after kLateStart steps
+  PileState warm_state = pile_state(n, r);
+  PileState cold_state = pile_state(n, r);
+  const PileRun warm = settle(warm_state, PileSolver::sor_warm, dt, t_end, &late, kLateStart);
+  const PileRun cold = settle(cold_state, PileSolver::sor_cold, dt, t_end);
+  // From the warm run's state at step kLateStart, kLateSteps steps with each warm solver.
+  const double t_late = late.t + kLateSteps * dt;
+  std::vector<PileRun> late_runs;
+  for (const PileSolver solver :
+       {PileSolver::sor_warm, PileSolver::newton_warm, PileSolver::hybrid_warm}) {
+    PileState state = late;
+    late_runs.push_back(settle(state, solver, dt, t_late));
+  }
   demo::OutputFile out(dir / "pile.csv",
                        "step,t,Ek_warm,contacts_warm,iterations_warm,converged_warm,"
                        "penetration_warm,residual_warm,Ek_cold,contacts_cold,iterations_cold,"
@@ -545,7 +609,8 @@ void pile(const std::filesystem::path& dir) {
   out.finish();
   value("pile.steps", "%zu", warm.reports.size());
   long iterations_of[2] = {0, 0};
-  for (const PileRun* run : {&warm, &cold}) {
+  for (const PileRun* run : std::initializer_list<const PileRun*>{
+           &warm, &cold, &late_runs[0], &late_runs[1], &late_runs[2]}) {
     // Iterations over the steps with contacts, and over the last quarter (the settled pile).
     long total = 0;
     long late = 0;
@@ -566,8 +631,15 @@ void pile(const std::filesystem::path& dir) {
       penetration = std::max(penetration, report.max_penetration);
     }
     const StepReport& last = run->reports.back();
-    const std::string key = run == &warm ? "pile.warm." : "pile.cold.";
-    iterations_of[run == &warm ? 0 : 1] = total;
+    const char* const name = run == &warm           ? "warm"
+                             : run == &cold         ? "cold"
+                             : run == &late_runs[0] ? "late_sor"
+                             : run == &late_runs[1] ? "late_newton"
+                                                    : "late_hybrid";
+    const std::string key = "pile." + std::string(name) + ".";
+    if (run == &warm || run == &cold) iterations_of[run == &warm ? 0 : 1] = total;
+    value((key + "solve").c_str(), "%.1f", run->solve_seconds);
+    value((key + "solve_ms").c_str(), "%.1f", 1e3 * run->solve_seconds / double(steps));
     value((key + "iterations").c_str(), "%.0f", double(total) / double(steps));
     value((key + "iterations_late").c_str(), "%.0f", double(late) / late_steps);
     value((key + "capped").c_str(), "%d", non_converged);
@@ -576,15 +648,15 @@ void pile(const std::filesystem::path& dir) {
     value((key + "contacts").c_str(), "%zu", last.contacts);
     value((key + "cpu").c_str(), "%.1f", run->seconds);
     value((key + "penetration").c_str(), "%s", tex_power(penetration).c_str());
-    say("pile of %zu spheres (r = %.0e m, mu = 0.5), %s start, dt = %.0e s, %.1f s: %zu contacts "
-        "at the end, E_kin %.1e J; iterations per step %.1f on average, %.1f over the last "
+    say("pile of %zu spheres (r = %.0e m, mu = 0.5), %s, dt = %.0e s, %zu steps to t = %.2f s: "
+        "%zu contacts at the end, E_kin %.1e J; iterations per step %.1f on average, %.1f over the last "
         "quarter (geometric mean of the residual ||F|| there %.1e); %d of %zu steps at "
         "max_iterations; "
-        "largest penetration %.2e m (%.1e r); %.1f s of CPU\n",
-        run->spheres, r, run == &warm ? "warm" : "cold", dt, t_end, last.contacts,
+        "largest penetration %.2e m (%.1e r); %.1f s of CPU, %.1f s of it in the solver\n",
+        run->spheres, r, name, dt, steps, last.t, last.contacts,
         last.kinetic_energy, double(total) / double(steps), double(late) / late_steps,
         std::exp(log_residual / late_steps), non_converged, steps, penetration, penetration / r,
-        run->seconds);
+        run->seconds, run->solve_seconds);
   }
   value("pile.warm.saves_iterations", "%.0f",
         100.0 * (1.0 - double(iterations_of[0]) / double(iterations_of[1])));

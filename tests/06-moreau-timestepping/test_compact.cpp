@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "grbd/contact/compact.hpp"
+#include "grbd/contact/delassus.hpp"
 #include "grbd/contact/prox.hpp"
 #include "grbd/contact/solver.hpp"
 #include "grbd/core/error.hpp"
@@ -91,6 +92,18 @@ TEST(CompactProblem, HasTheContactVelocitiesAndDelassusBlocksOfTheBodyForm) {
     EXPECT_LE((G - G.transpose()).norm(), 1e-15 * G.norm());
     EXPECT_LE((delassus_diagonal(c, r.problem.M_inv) - G.diagonal()).norm(), 1e-14 * G.norm());
   }
+  // The assembled W of both forms: one matrix, block by block (the body form's W is checked
+  // against the bodies' velocity response in chapter 5's tests).
+  grbd::contact::BlockSparseMatrix W_compact, W_body;
+  grbd::contact::assemble_delassus(r.problem, W_compact);
+  grbd::contact::assemble_delassus(body, W_body);
+  ASSERT_EQ(W_compact.row_start, W_body.row_start);
+  ASSERT_EQ(W_compact.column, W_body.column);
+  ASSERT_EQ(W_compact.diagonal, W_body.diagonal);
+  for (std::size_t k = 0; k < W_body.blocks.size(); ++k) {
+    EXPECT_LE((W_compact.blocks[k] - W_body.blocks[k]).norm(), 1e-13 * (1.0 + W_body.blocks[k].norm()))
+        << "block " << k;
+  }
 }
 
 TEST(CompactProblem, SolvesToTheSolutionOfTheBodyFormWithEveryMethod) {
@@ -101,7 +114,21 @@ TEST(CompactProblem, SolvesToTheSolutionOfTheBodyFormWithEveryMethod) {
   options.rel_tol = 1e-12;
   options.max_iterations = 200000;
   options.criterion = Criterion::natural_residual;
-  for (const Method method : {Method::sor, Method::jor, Method::apgd}) {
+  // Newton three ways: GMRES (W never formed), the sparse LU of the assembled W, the hybrid.
+  struct Variant {
+    Method method;
+    grbd::contact::LinearSolver linear = grbd::contact::LinearSolver::automatic;
+    int hybrid_sweeps = 0;
+  };
+  for (const Variant variant :
+       {Variant{Method::sor}, Variant{Method::jor}, Variant{Method::apgd},
+        Variant{Method::newton, grbd::contact::LinearSolver::gmres},
+        Variant{Method::newton, grbd::contact::LinearSolver::direct},
+        Variant{Method::newton, grbd::contact::LinearSolver::automatic, 100}}) {
+    const Method method = variant.method;
+    options.newton.linear_solver = variant.linear;
+    options.newton.hybrid_sweeps = variant.hybrid_sweeps;
+    if (method == Method::newton) options.max_iterations = 200;
     ContactSolution compact_solution;
     ContactSolution body_solution;
     ContactSolver compact_solver(method, options);

@@ -25,6 +25,7 @@
 #include <string>
 #include <utility>
 
+#include "grbd/contact/delassus.hpp"
 #include "grbd/contact/newton.hpp"
 #include "grbd/contact/prox.hpp"
 #include "grbd/core/checks.hpp"
@@ -56,6 +57,7 @@ struct detail::SolverWorkspace {
   std::vector<Vector3> d, wd, trial, trial_xi, x3, y3;
   std::vector<double> merits, rhs, step;
   GmresWorkspace gmres;
+  BlockSparseMatrix W;                ///< W assembled (body and compact forms, direct)
   std::vector<Eigen::Triplet<double>> triplets;
   Eigen::SparseMatrix<double> jacobian;
   Eigen::SparseLU<Eigen::SparseMatrix<double>> lu;
@@ -175,6 +177,13 @@ void validate_options(const SolverOptions& o, const char* solver) {
                           std::to_string(n.max_linear_iterations) + ", " +
                           std::to_string(n.line_search_memory) + ", " +
                           std::to_string(n.fallback_sweeps));
+  }
+  if (n.hybrid_sweeps < 0 || !(n.hybrid_stagnation > 0.0 && n.hybrid_stagnation <= 1.0)) {
+    throw InvalidArgument(where() +
+                          "expected newton.hybrid_sweeps >= 0 and newton.hybrid_stagnation in "
+                          "(0, 1]; found " +
+                          std::to_string(n.hybrid_sweeps) + ", " +
+                          format_number(n.hybrid_stagnation));
   }
 }
 
@@ -315,6 +324,8 @@ class BodyModel {
       if (c.body_b != kStatic) y[i] -= c.W_b.transpose() * v[c.body_b];
     }
   }
+  /// W = Wᵀ M⁻¹ W assembled, for Newton's direct linear solver.
+  void assemble(BlockSparseMatrix& W) const { assemble_delassus(problem_, W); }
   /// Makes u consistent with Λ.
   void synchronize() { body_velocities(lambda_, u_); }
   /// Brings the body velocities u of the hook up to date with Λ.
@@ -475,6 +486,8 @@ class CompactModel {
     y.resize(size());
     for (std::size_t i = 0; i < size(); ++i) y[i] = contact_velocity(problem_.contacts[i], v);
   }
+  /// W = Wᵀ M⁻¹ W assembled, for Newton's direct linear solver.
+  void assemble(BlockSparseMatrix& W) const { assemble_delassus(problem_, W); }
   void synchronize() { body_velocities(lambda_, u_); }
   void update_u() { synchronize(); }
   void record(const std::vector<Vector3>& /*xi*/, bool velocity_watched) {
@@ -957,19 +970,37 @@ class NewtonPolicy {
         velocity_watched_(options.criterion == Criterion::velocity_change),
         ws_(ws),
         result_(result) {
-    direct_ = options.newton.linear_solver == LinearSolver::direct;
-    if constexpr (requires { model.block_matrix(); }) {
-      direct_ = direct_ || options.newton.linear_solver == LinearSolver::automatic;
-    } else if (direct_) {
-      throw InvalidArgument("Newton: the direct linear solver needs W, which only the local form "
-                            "(FCLIB) has; use newton.linear_solver = gmres");
+    switch (options.newton.linear_solver) {
+      case LinearSolver::direct:
+        direct_ = true;
+        break;
+      case LinearSolver::gmres:
+        direct_ = false;
+        break;
+      case LinearSolver::automatic:
+        direct_ = requires { model.block_matrix(); };
+        break;
     }
     ws.merits.clear();
     gather_mu(model, ws);  // for the residual of the projected percussions (accept())
-    if (direct_) pattern();
+    if (direct_) {
+      if constexpr (requires { model.block_matrix(); }) {
+        W_ = &model.block_matrix();
+      } else {
+        model.assemble(ws.W);
+        W_ = &ws.W;
+      }
+      pattern();
+    }
+    hybrid_ = options.newton.hybrid_sweeps > 0;
   }
 
   void iterate(int /*k*/) {
+    if (hybrid_) {
+      hybrid_ = false;
+      hybrid_phase();
+      return;
+    }
     const std::size_t n = model_.size();
     const std::span<Vector3> lambda = model_.lambda();
     // Φ and J = A + B W at the iterate. Φ is divided by its largest component, `scale_`, for the
@@ -1045,23 +1076,61 @@ class NewtonPolicy {
   void finish() { model_.done(); }
 
  private:
+  /// The hybrid's SOR phase, the whole of its first iteration: SOR sweeps until ‖F‖ fell by
+  /// less than the factor hybrid_stagnation over the last newton::kHybridWindow sweeps, or (with
+  /// the natural-residual criterion) meets the tolerance or would not meet it within the sweeps
+  /// left at the rate of the last window, or (with the percussion criterion) the last sweep of
+  /// a window met it, or hybrid_sweeps sweeps are done.
+  void hybrid_phase() {
+    const NewtonOptions& o = options_.newton;
+    double window_residual = 0.0;  // ‖F‖ at the end of the last window
+    const double tolerance = options_.criterion == Criterion::natural_residual
+                                 ? options_.abs_tol + options_.rel_tol * result_.norm_c
+                                 : -1.0;
+    const bool percussions = options_.criterion == Criterion::percussion_change;
+    while (result_.hybrid_sweeps < o.hybrid_sweeps) {
+      const bool last_of_window = (result_.hybrid_sweeps + 1) % newton::kHybridWindow == 0;
+      if (last_of_window && percussions) {
+        ws_.trial.assign(model_.lambda().begin(), model_.lambda().end());
+      }
+      model_.sor_sweep(ws_.r, ProxForm::alart_curnier);
+      ++result_.hybrid_sweeps;
+      if (!last_of_window) continue;
+      // The percussion criterion met by the window's last sweep: SOR has converged.
+      if (percussions && has_converged(flat(std::span<const Vector3>(ws_.trial)),
+                                       flat(std::span<const Vector3>(model_.lambda())),
+                                       options_.abs_tol, options_.rel_tol)) {
+        break;
+      }
+      model_.velocities(model_.lambda(), ws_.xi);
+      const double residual = residual_norm(model_.lambda(), ws_.xi, ws_.mu);
+      if (!std::isfinite(residual) || residual <= tolerance) break;
+      if (window_residual > 0.0) {
+        const double rate = residual / window_residual;  // per window
+        if (rate > o.hybrid_stagnation) break;
+        // Windows to the tolerance at this rate, against the windows left.
+        const double left = double(o.hybrid_sweeps - result_.hybrid_sweeps) / newton::kHybridWindow;
+        if (tolerance > 0.0 && std::log(tolerance / residual) / std::log(rate) > left) break;
+      }
+      window_residual = residual;
+    }
+    model_.touched();
+  }
+
   /// The direct solver's pattern: that of W (every diagonal block stored), analysed once.
   void pattern() {
-    if constexpr (requires { model_.block_matrix(); }) {
-      const BlockSparseMatrix& W = model_.block_matrix();
-      const auto m = static_cast<Eigen::Index>(3 * W.size());
-      fill_triplets();
-      ws_.jacobian.resize(m, m);
-      ws_.jacobian.setFromTriplets(ws_.triplets.begin(), ws_.triplets.end());
-      ws_.lu.analyzePattern(ws_.jacobian);
-    }
+    const auto m = static_cast<Eigen::Index>(3 * W_->size());
+    fill_triplets();
+    ws_.jacobian.resize(m, m);
+    ws_.jacobian.setFromTriplets(ws_.triplets.begin(), ws_.triplets.end());
+    ws_.lu.analyzePattern(ws_.jacobian);
   }
 
   /// J's entries as triplets, block (i, j) = B_i W_ij + δ_ij A_i (zeros before the first
   /// iterate: the pattern is W's, whatever the values).
   void fill_triplets() {
-    if constexpr (requires { model_.block_matrix(); }) {
-      const BlockSparseMatrix& W = model_.block_matrix();
+    {
+      const BlockSparseMatrix& W = *W_;
       const std::size_t n = W.size();
       ws_.triplets.clear();
       const bool values = ws_.ac.size() == n;
@@ -1218,6 +1287,8 @@ class NewtonPolicy {
   Workspace& ws_;
   SolverResult& result_;
   bool direct_ = false;
+  const BlockSparseMatrix* W_ = nullptr;  // W for the direct solver: the problem's or ws_.W
+  bool hybrid_ = false;                   // the hybrid's SOR phase is still to come
   double phi0_ = 0.0;  // ‖Φ‖ at the first iterate, the scale of GMRES's forcing term
   double epsilon_ = newton::kInitialRegularization;  // J + εI: Levenberg–Marquardt's ε
   double scale_ = 1.0;  // the largest component of Φ at the iterate

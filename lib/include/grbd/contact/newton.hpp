@@ -98,6 +98,11 @@ inline constexpr double kMaxRegularization = 1.0;        ///< ε at most
 /// a rough solve far from the solution, an ever more exact one near it, which keeps the rate
 /// quadratic (Eisenstat and Walker 1996, choice with exponent 2 in relative terms).
 inline constexpr double kMaxForcing = 0.1;
+/// The hybrid (NewtonOptions::hybrid_sweeps) compares ‖F‖ every this many SOR sweeps: one
+/// evaluation of ξ per window, a twenty-fifth of a sweep's work per sweep, and long enough that
+/// the erratic decrease of Gauss–Seidel over a few sweeps averages out (over windows of 10
+/// sweeps, SOR that converges in 1600 sweeps on a pile of chapter 5 looked stagnant early on).
+inline constexpr int kHybridWindow = 25;
 }  // namespace newton
 
 /// The operator of a Newton system, applied without forming it: y = J x.

@@ -124,10 +124,12 @@ inline constexpr double kDecreaseSlack = 1e-12;
 
 /// How the Newton method solves its linear system J d = −Φ in each iteration.
 enum class LinearSolver {
-  /// direct in the local form (FCLIB), where W is at hand; GMRES in the body and compact forms
+  /// direct in the local form (FCLIB), where W is at hand; GMRES in the body and compact forms,
+  /// where a sphere packing's J fills in badly under the LU factorization (chapter 5 measures both)
   automatic,
   /// a sparse LU factorization of J = A + B W assembled from W's blocks (Eigen's SparseLU, the
-  /// pattern analysed once per solve): local form only
+  /// pattern analysed once per solve); in the body and compact forms W = Wᵀ M⁻¹ W is assembled
+  /// once per solve (delassus_matrix())
   direct,
   /// restarted GMRES with J applied as A x + B (W x), W never formed, and the block-diagonal
   /// preconditioner (A_i + B_i W_ii)⁻¹; every form
@@ -147,6 +149,18 @@ struct NewtonOptions {
   /// When the Newton direction fails (no descent, no step passes the line search, a singular J):
   /// this many SOR sweeps (Alart–Curnier form, SOR's r-factors) instead, >= 1.
   int fallback_sweeps = 5;
+  /// The hybrid: SOR sweeps (Alart–Curnier form, SOR's r-factors) first, at most this many, and
+  /// Newton from where they stagnate: when ‖F‖ fell by less than the factor hybrid_stagnation
+  /// over the last newton::kHybridWindow sweeps, or, with the natural-residual criterion, when
+  /// at the rate of the last window SOR would not meet the tolerance within the sweeps left (and
+  /// SOR alone where it does). The SOR phase is the solver's first iteration
+  /// (the stopping test and the hooks see it as one; max_iterations counts it as one); it ends
+  /// early where SOR meets the natural-residual or the percussion criterion (tested at the end
+  /// of each window). 0, the default, is Newton from the start.
+  int hybrid_sweeps = 0;
+  /// The hybrid's stagnation factor, in (0, 1]: 1 runs all hybrid_sweeps sweeps unless SOR
+  /// converges first.
+  double hybrid_stagnation = 0.99;
 };
 // [newton options]
 
@@ -191,6 +205,8 @@ struct SolverResult {
   /// Newton: the linear solver's work, products with J (GMRES) or factorizations (direct)
   int linear_iterations = 0;
   int fallbacks = 0;             ///< Newton: iterations that fell back to SOR sweeps
+  /// Newton: the SOR sweeps of the hybrid's first iteration (NewtonOptions::hybrid_sweeps)
+  int hybrid_sweeps = 0;
   std::vector<double> history;   ///< ‖F‖ after each iteration, when record_history
   /// ‖F‖/‖c‖ (FCLIB's classic measure); ‖F‖ when ‖c‖ = 0.
   double relative_residual() const { return norm_c > 0.0 ? residual / norm_c : residual; }
