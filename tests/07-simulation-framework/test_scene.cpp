@@ -187,6 +187,25 @@ TEST(SceneFile, OutOfRangeValuesNameTheKeyTheRangeAndTheValue) {
       "(did you mean \"sor\"?), found the string \"sore\"");
 }
 
+// Newton's keys reach the stepper's settings, and bad values are refused by name.
+TEST(SceneFile, NewtonsLinearSolverAndHybridAreSceneKeys) {
+  const Scene scene = parse_scene(
+      replace(kMinimal, "[simulation]",
+              "[solver]\nmethod = \"newton\"\nlinear_solver = \"direct\"\nhybrid_sweeps = 300\n"
+              "[simulation]"),
+      "scene.toml");
+  EXPECT_EQ(scene.settings.method, grbd::contact::Method::newton);
+  EXPECT_EQ(scene.settings.solver.newton.linear_solver, grbd::contact::LinearSolver::direct);
+  EXPECT_EQ(scene.settings.solver.newton.hybrid_sweeps, 300);
+  grbd::scene::Simulation simulation(scene);
+  EXPECT_EQ(error_of(replace(kMinimal, "[simulation]", "[solver]\nhybrid_sweeps = -1\n[simulation]")),
+            "scene.toml:2:17: solver.hybrid_sweeps: expected an integer in [0, 100000000], found "
+            "the integer -1");
+  EXPECT_NE(error_of(replace(kMinimal, "[simulation]", "[solver]\nlinear_solver = \"lu\"\n[simulation]"))
+                .find("solver.linear_solver: expected one of \"automatic\", \"direct\", \"gmres\""),
+            std::string::npos);
+}
+
 TEST(SceneFile, MaterialsAndPairsMustBeDeclared) {
   EXPECT_EQ(error_of(replace(kMinimal, "material = \"glass\"", "material = \"glas\"")),
             "scene.toml:14:12: bodies[0].material: expected the name of a declared material "

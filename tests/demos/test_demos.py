@@ -100,7 +100,8 @@ class BadDirectory(DemoCase):
         # Every demo checks its data directory before it computes anything; extra arguments
         # (ch02_space_donut's mesh, ch05_fclib's problems) are valid or never reached.
         extra = {"ch02_space_donut": [self.tmp / "space_donut.obj"],
-                 "ch05_fclib": [Path(FCLIB_DATA) / SMALL_FCLIB]}
+                 "ch05_fclib": [Path(FCLIB_DATA) / SMALL_FCLIB],
+                 "ch05_profile": [Path(FCLIB_DATA)]}
         for label, path, reason in self.bad_paths():
             for name in DEMOS:
                 with self.subTest(demo=name, path=label):
@@ -137,6 +138,7 @@ WRITE_CASES = [
     ("ch03_work_precision", "explicit_exp_map.csv", []),
     ("ch04_scaling", "scaling.csv", []),
     ("ch05_convergence", "convergence.csv", []),
+    ("ch05_profile", "runs.csv", ["FCLIB_DIR"]),
     ("ch02_make_meshes", "box.obj", []),
 ]
 
@@ -145,11 +147,14 @@ class BrokenOutput(DemoCase):
     """Runs the demos of WRITE_CASES with one output file replaced by `self.replace(path)`."""
 
     def arguments(self, extra):
-        """The extra arguments: FCLIB is the small shipped problem, MESH the donut's OBJ file."""
+        """The extra arguments: FCLIB is the small shipped problem, FCLIB_DIR the folder of the
+        shipped problems, MESH the donut's OBJ file."""
         result = []
         for argument in extra:
             if argument == "FCLIB":
                 result.append(Path(FCLIB_DATA) / SMALL_FCLIB)
+            elif argument == "FCLIB_DIR":
+                result.append(Path(FCLIB_DATA))
             elif argument == "MESH":
                 meshes = self.tmp / "meshes"
                 if not (meshes / "space_donut.obj").exists():

@@ -555,6 +555,10 @@ void read_solver(TableReader& t, Scene& scene) {
   s.solver.alpha = t.real("alpha", s.solver.alpha, Range{0.0, 2.0, true, true});
   s.solver.criterion = static_cast<contact::Criterion>(
       t.choice("criterion", {"percussion_change", "velocity_change", "natural_residual"}, 0));
+  s.solver.newton.linear_solver = static_cast<contact::LinearSolver>(
+      t.choice("linear_solver", {"automatic", "direct", "gmres"}, 0));
+  s.solver.newton.hybrid_sweeps =
+      static_cast<int>(t.integer("hybrid_sweeps", s.solver.newton.hybrid_sweeps, 0, 100000000));
   s.warm_start = t.boolean("warm_start", s.warm_start);
   s.on_non_convergence = static_cast<timestep::NonConvergence>(
       t.choice("on_non_convergence", {"count", "warn", "stop"}, 0));
