@@ -658,6 +658,8 @@ void pile(const std::filesystem::path& dir) {
         std::exp(log_residual / late_steps), non_converged, steps, penetration, penetration / r,
         run->seconds, run->solve_seconds);
   }
+  value("pile.late.newton_over_sor", "%.0f", late_runs[1].solve_seconds / late_runs[0].solve_seconds);
+  value("pile.late.hybrid_over_sor", "%.0f", late_runs[2].solve_seconds / late_runs[0].solve_seconds);
   value("pile.warm.saves_iterations", "%.0f",
         100.0 * (1.0 - double(iterations_of[0]) / double(iterations_of[1])));
   value("pile.warm.saves_time", "%.0f", 100.0 * (1.0 - warm.seconds / cold.seconds));
