@@ -196,12 +196,17 @@ int main(int argc, char** argv) {
                       r.linear_iterations, r.hybrid_sweeps, 1e3 * r.seconds,
                       r.relative_residual());
         csv << line;
+        // Milliseconds to three digits, whole ones from 100 on (no exponent in the table).
+        const double ms = 1e3 * r.seconds;
+        const char* const ms_format = ms < 100.0 ? "%.3g" : "%.0f";
+        char ms_text[32];
+        std::snprintf(ms_text, sizeof ms_text, ms_format, ms);
         if (r.converged && solver == "Hybrid") {
           // SOR sweeps + Newton iterations (the SOR phase is the first iteration).
-          std::snprintf(line, sizeof line, "%d + %d / %.3g", r.hybrid_sweeps, r.iterations - 1,
-                        1e3 * r.seconds);
+          std::snprintf(line, sizeof line, "%d + %d / %s", r.hybrid_sweeps, r.iterations - 1,
+                        ms_text);
         } else if (r.converged) {
-          std::snprintf(line, sizeof line, "%d / %.3g", r.iterations, 1e3 * r.seconds);
+          std::snprintf(line, sizeof line, "%d / %s", r.iterations, ms_text);
         } else {
           std::snprintf(line, sizeof line, "— (\\f$%s\\f$)",
                         grbd::demo::tex_power(r.relative_residual()).c_str());
