@@ -18,8 +18,9 @@
 //   profile.csv  tau, then ρ_s(τ) per solver, at every ratio that occurs
 //   profile.txt  the runs as a table
 //   values.txt   the numbers the chapter quotes (\demo{ch05_profile/values.txt#KEY}):
-//                <problem>.<solver> = "iterations / ms" (the hybrid: "sweeps + Newton
-//                iterations / ms") or "—" (failed, with its residual),
+//                <problem>.<solver> = "iterations / ms" (Newton: "iterations (linear) / ms",
+//                the hybrid: "sweeps + Newton iterations (linear) / ms", linear = LU
+//                factorizations or GMRES products) or "—" (failed, with its residual),
 //                <problem>.contacts, best1.<solver> (problems where s is fastest),
 //                solved.<solver> (problems solved), problems, tol
 //
@@ -202,8 +203,12 @@ int main(int argc, char** argv) {
         char ms_text[32];
         std::snprintf(ms_text, sizeof ms_text, ms_format, ms);
         if (r.converged && solver == "Hybrid") {
-          // SOR sweeps + Newton iterations (the SOR phase is the first iteration).
-          std::snprintf(line, sizeof line, "%d + %d / %s", r.hybrid_sweeps, r.iterations - 1,
+          // SOR sweeps + Newton iterations (the SOR phase is the first iteration), the linear
+          // solver's work in parentheses.
+          std::snprintf(line, sizeof line, "%d + %d (%d) / %s", r.hybrid_sweeps,
+                        r.iterations - 1, r.linear_iterations, ms_text);
+        } else if (r.converged && solver == "Newton") {
+          std::snprintf(line, sizeof line, "%d (%d) / %s", r.iterations, r.linear_iterations,
                         ms_text);
         } else if (r.converged) {
           std::snprintf(line, sizeof line, "%d / %s", r.iterations, ms_text);
