@@ -129,7 +129,7 @@ enum class LinearSolver {
   automatic,
   /// a sparse LU factorization of J = A + B W assembled from W's blocks (Eigen's SparseLU, the
   /// pattern analysed once per solve); in the body and compact forms W = Wᵀ M⁻¹ W is assembled
-  /// once per solve (delassus_matrix())
+  /// once per solve (assemble_delassus(), grbd/contact/delassus.hpp)
   direct,
   /// restarted GMRES with J applied as A x + B (W x), W never formed, and the block-diagonal
   /// preconditioner (A_i + B_i W_ii)⁻¹; every form
