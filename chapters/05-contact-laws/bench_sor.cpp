@@ -75,11 +75,8 @@ void BM_solve(benchmark::State& state) {
   options.abs_tol = 0.0;
   options.rel_tol = 1e-6;
   options.max_iterations = 20000;
-  ContactSolution first;
-  grbd::contact::solve_sor(pile.problem, first, options);
   grbd::contact::WarmStart previous;
-  previous.store(pile.problem.keys, first.lambda);
-  grbd::demo::advance(pile, first.u);
+  grbd::demo::solve_and_advance(pile, options, previous);
   if (solver == kJor) {
     options.alpha = 0.3;
     options.r_strategy = RFactorStrategy::global;

@@ -131,12 +131,9 @@ int main(int argc, char** argv) {
   try {
     const std::filesystem::path dir = argv[1];
     grbd::demo::SpherePile pile = grbd::demo::sphere_pile(8, 8, 1);
-    ContactSolution first;
-    const SolverResult first_result =
-        grbd::contact::solve_sor(pile.problem, first, options_for("SOR"));
     grbd::contact::WarmStart previous;
-    previous.store(pile.problem.keys, first.lambda);
-    grbd::demo::advance(pile, first.u);
+    const SolverResult first_result =
+        grbd::demo::solve_and_advance(pile, options_for("SOR"), previous);
 
     grbd::demo::OutputFile table(dir / "convergence.txt");
     char line[256];

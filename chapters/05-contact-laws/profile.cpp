@@ -161,13 +161,10 @@ int main(int argc, char** argv) {
       if (pile.second_step) {
         // The second step: the first one solved (SOR to the tolerance), advanced, warm-started.
         grbd::demo::SpherePile next = packings.back();
-        ContactSolution first;
         SolverOptions options = options_for("SOR");
         options.max_iterations = 100000;
-        grbd::contact::solve_sor(next.problem, first, options);
         grbd::contact::WarmStart previous;
-        previous.store(next.problem.keys, first.lambda);
-        grbd::demo::advance(next, first.u);
+        grbd::demo::solve_and_advance(next, options, previous);
         std::vector<grbd::Vector3> guess;
         previous.initialize(next.problem.keys, guess);
         packings.push_back(std::move(next));

@@ -17,6 +17,8 @@
 #include "grbd/collision/broad_phase.hpp"
 #include "grbd/collision/world.hpp"
 #include "grbd/contact/problem.hpp"
+#include "grbd/contact/solver.hpp"
+#include "grbd/contact/warm_start.hpp"
 #include "grbd/kinematics/exponential.hpp"
 #include "grbd/kinematics/quaternion.hpp"
 
@@ -51,6 +53,19 @@ inline void advance(SpherePile& pile, const std::vector<Vector6>& u) {
   for (Vector6& v : u_free) v(2) -= 9.81 * pile.h;
   pile.problem = contact::assemble_problem(pile.contacts, pile.bodies, pile.states, u_free,
                                            contact::ContactMaterial{pile.mu, 0.0, 0.0});
+}
+
+/// Solves the pile's problem with SOR and `options`, stores its percussions by contact key in
+/// `previous` and advances the pile to the next step with its end velocities (advance()): the
+/// next problem, with its warm start at hand (previous.initialize()). Returns SOR's result.
+inline contact::SolverResult solve_and_advance(SpherePile& pile,
+                                               const contact::SolverOptions& options,
+                                               contact::WarmStart& previous) {
+  contact::ContactSolution first;
+  const contact::SolverResult result = contact::solve_sor(pile.problem, first, options);
+  previous.store(pile.problem.keys, first.lambda);
+  advance(pile, first.u);
+  return result;
 }
 
 /// A pile of nx × ny × nz FCC cells (4 spheres each) of radius r, time step h, friction μ.

@@ -960,7 +960,8 @@ class ApgdPolicy {
 };
 
 /// Newton: one semismooth Newton step on the Alart–Curnier function per iteration (newton.hpp),
-/// with a non-monotone Armijo line search on ψ = ½‖Φ‖² and SOR sweeps where the step fails.
+/// with an Armijo line search on ψ = ½‖Φ‖² (non-monotone as an option) and SOR sweeps where the
+/// step fails; the hybrid's SOR phase first when asked.
 template <class Model>
 class NewtonPolicy {
  public:
@@ -1129,73 +1130,68 @@ class NewtonPolicy {
   /// J's entries as triplets, block (i, j) = B_i W_ij + δ_ij A_i (zeros before the first
   /// iterate: the pattern is W's, whatever the values).
   void fill_triplets() {
-    {
-      const BlockSparseMatrix& W = *W_;
-      const std::size_t n = W.size();
-      ws_.triplets.clear();
-      const bool values = ws_.ac.size() == n;
-      for (std::size_t i = 0; i < n; ++i) {
-        for (std::int64_t k = W.row_start[i]; k < W.row_start[i + 1]; ++k) {
-          const auto j = static_cast<std::size_t>(W.column[k]);
-          Matrix3 block = Matrix3::Zero();
-          if (values) {
-            block = ws_.ac[i].B * W.blocks[k];
-            if (j == i) block += ws_.ac[i].A + epsilon_ * Matrix3::Identity();
-          }
-          for (int a = 0; a < 3; ++a) {
-            for (int b = 0; b < 3; ++b) {
-              ws_.triplets.emplace_back(static_cast<Eigen::Index>(3 * i + a),
-                                        static_cast<Eigen::Index>(3 * j + b), block(a, b));
-            }
+    const BlockSparseMatrix& W = *W_;
+    const std::size_t n = W.size();
+    ws_.triplets.clear();
+    const bool values = ws_.ac.size() == n;
+    for (std::size_t i = 0; i < n; ++i) {
+      for (std::int64_t k = W.row_start[i]; k < W.row_start[i + 1]; ++k) {
+        const auto j = static_cast<std::size_t>(W.column[k]);
+        Matrix3 block = Matrix3::Zero();
+        if (values) {
+          block = ws_.ac[i].B * W.blocks[k];
+          if (j == i) block += ws_.ac[i].A + epsilon_ * Matrix3::Identity();
+        }
+        for (int a = 0; a < 3; ++a) {
+          for (int b = 0; b < 3; ++b) {
+            ws_.triplets.emplace_back(static_cast<Eigen::Index>(3 * i + a),
+                                      static_cast<Eigen::Index>(3 * j + b), block(a, b));
           }
         }
       }
     }
   }
 
-  /// d with J d = −Φ; false when the linear solver fails (a singular J, a non-finite d).
+  /// d with J d = −Φ; false when the linear solver fails (a singular J, a non-finite d). Both
+  /// linear solvers work on flat vectors in the workspace: the right-hand side −Φ / scale in
+  /// `rhs`, the solution d / scale in `step`.
   bool direction(double norm_phi) {
     const std::size_t n = model_.size();
-    ws_.d.resize(n);
+    ws_.rhs.resize(3 * n);
+    ws_.step.resize(3 * n);
+    for (std::size_t i = 0; i < n; ++i) {
+      for (int a = 0; a < 3; ++a) ws_.rhs[3 * i + a] = -ws_.ac[i].phi(a) / scale_;
+    }
     if (direct_) {
       fill_triplets();
       ws_.jacobian.setFromTriplets(ws_.triplets.begin(), ws_.triplets.end());
       ws_.lu.factorize(ws_.jacobian);
       ++result_.linear_iterations;
       if (ws_.lu.info() != Eigen::Success) return false;
-      Eigen::VectorXd b(static_cast<Eigen::Index>(3 * n));
+      const auto m = static_cast<Eigen::Index>(3 * n);
+      Eigen::Map<Eigen::VectorXd>(ws_.step.data(), m) =
+          ws_.lu.solve(Eigen::Map<const Eigen::VectorXd>(ws_.rhs.data(), m));
+      if (ws_.lu.info() != Eigen::Success) return false;
+    } else {
+      // GMRES on J = A + B W with the block-diagonal preconditioner (A_i + B_i W_ii)⁻¹ (the
+      // identity for a block that is singular).
+      ws_.precond.resize(n);
       for (std::size_t i = 0; i < n; ++i) {
-        b.segment<3>(static_cast<Eigen::Index>(3 * i)) = -ws_.ac[i].phi / scale_;
+        const Matrix3 M =
+            ws_.ac[i].A + ws_.ac[i].B * model_.delassus(i) + epsilon_ * Matrix3::Identity();
+        bool invertible = false;
+        double det = 0.0;
+        M.computeInverseAndDetWithCheck(ws_.precond[i], det, invertible);
+        if (!invertible || !ws_.precond[i].allFinite()) ws_.precond[i].setIdentity();
       }
-      const Eigen::VectorXd x = ws_.lu.solve(b);
-      if (ws_.lu.info() != Eigen::Success || !x.allFinite()) return false;
-      for (std::size_t i = 0; i < n; ++i) {
-        ws_.d[i] = x.segment<3>(static_cast<Eigen::Index>(3 * i));  // d / scale
-      }
-      return true;
+      const Operator J(model_, ws_, epsilon_);
+      const double forcing = std::min(newton::kMaxForcing, norm_phi / phi0_);
+      const GmresResult g =
+          gmres(J, ws_.rhs, ws_.step, forcing * norm_phi / scale_, options_.newton.krylov_restart,
+                options_.newton.max_linear_iterations, ws_.gmres);
+      result_.linear_iterations += g.iterations;
     }
-    // GMRES on J = A + B W with the block-diagonal preconditioner (A_i + B_i W_ii)⁻¹ (the identity
-    // for a block that is singular).
-    ws_.precond.resize(n);
-    for (std::size_t i = 0; i < n; ++i) {
-      const Matrix3 M =
-          ws_.ac[i].A + ws_.ac[i].B * model_.delassus(i) + epsilon_ * Matrix3::Identity();
-      bool invertible = false;
-      double det = 0.0;
-      M.computeInverseAndDetWithCheck(ws_.precond[i], det, invertible);
-      if (!invertible || !ws_.precond[i].allFinite()) ws_.precond[i].setIdentity();
-    }
-    ws_.rhs.resize(3 * n);
-    ws_.step.resize(3 * n);
-    for (std::size_t i = 0; i < n; ++i) {
-      for (int a = 0; a < 3; ++a) ws_.rhs[3 * i + a] = -ws_.ac[i].phi(a) / scale_;
-    }
-    const Operator J(model_, ws_, epsilon_);
-    const double forcing = std::min(newton::kMaxForcing, norm_phi / phi0_);
-    const GmresResult g =
-        gmres(J, ws_.rhs, ws_.step, forcing * norm_phi / scale_, options_.newton.krylov_restart,
-              options_.newton.max_linear_iterations, ws_.gmres);
-    result_.linear_iterations += g.iterations;
+    ws_.d.resize(n);
     for (std::size_t i = 0; i < n; ++i) {
       ws_.d[i] = Vector3(ws_.step[3 * i], ws_.step[3 * i + 1], ws_.step[3 * i + 2]);  // d / scale
     }
