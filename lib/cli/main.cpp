@@ -19,8 +19,10 @@
 //        output closed; `grbd run <scene> --restart <checkpoint>` continues
 //
 // Under mpirun (mpirun -np P grbd run ...) the run is shared among the processes (chapter 8):
-// rank 0 prints progress, summary and errors; every process exits with the same code, except
-// after a failed step, which ends every process through MPI_Abort with code 1.
+// rank 0 prints progress, summary and errors; every process exits with the same code. A step that
+// fails on one process while the others wait in its exchanges ends every process through
+// MPI_Abort with code 1 once the agreement's patience has passed. A signal to mpirun itself:
+// mpirun's own exit code (Open MPI: 1), after every process has written its checkpoint.
 
 #include <spawn.h>
 #include <sys/wait.h>
@@ -33,6 +35,7 @@
 #include <cmath>
 #include <csignal>
 #include <cstdio>
+#include <cstring>
 #include <deque>
 #include <filesystem>
 #include <fstream>
@@ -47,6 +50,7 @@
 #include <vector>
 
 #include "grbd/contact/fclib_bench.hpp"
+#include "grbd/core/checks.hpp"
 #include "grbd/io/output.hpp"
 #include "grbd/io/run.hpp"
 #include "grbd/parallel/chute.hpp"
@@ -71,7 +75,9 @@ constexpr const char* kExitCodes =
     "(scene, checkpoint, output or FCLIB file; an output folder that cannot be written; an "
     "existing result without --force), nothing run or changed; 4 stopped by the stop file after "
     "writing a checkpoint; 130 / 143 stopped by SIGINT / SIGTERM after writing a checkpoint "
-    "(continue with --restart). Under mpirun, a failed step ends every process with 1.";
+    "(continue with --restart). Under mpirun every process exits with the same code and rank 0 "
+    "reports it; a signal to mpirun itself ends it with mpirun's own code (Open MPI: 1) once every "
+    "process has written the checkpoint: the stop file (4) is the way to a code of grbd's.";
 constexpr const char* kSceneFormat =
     "The scene format: chapter 7 of the book, section \"Scene files\" (every key, its unit, "
     "default and range).";
@@ -81,8 +87,9 @@ constexpr const char* kValidateExitCodes =
 constexpr const char* kInfoExitCodes =
     "Exit codes: 0 done; 2 bad command line; 3 not a readable grbd output file.";
 constexpr const char* kChuteExitCodes =
-    "Exit codes: 0 done; 1 the CSV could not be written; 2 bad command line; 3 not a readable "
-    "grbd output file.";
+    "Exit codes: 0 done; 1 the CSV could not be written; 2 bad command line (also a --csv that is "
+    "the output, its XDMF or scene, a folder, a device or FIFO, a read-only file); 3 not a "
+    "readable grbd output file (or one a run is writing).";
 constexpr const char* kFclibExitCodes =
     "Exit codes: 0 every problem was solved (converged or not: the table says); 1 the CSV could "
     "not be written; 2 bad command line (also a CSV that is one of the problems); 3 a file the "
@@ -187,12 +194,39 @@ class Progress {
   std::deque<std::pair<std::chrono::steady_clock::time_point, std::uint64_t>> samples_;
 };
 
+// Throws InvalidArgument on a process whose scene text or end time differs from rank 0's: the
+// processes of one run must run one scene.
+void same_as_rank_0(const grbd::Communicator& world, const grbd::scene::Scene& scene,
+                    const std::string& scene_file) {
+  if (world.size() == 1) return;
+  std::vector<std::byte> bytes(sizeof(double) + scene.text.size());
+  std::memcpy(bytes.data(), &scene.end_time, sizeof(double));
+  std::memcpy(bytes.data() + sizeof(double), scene.text.data(), scene.text.size());
+  std::vector<std::byte> theirs = bytes;
+  world.broadcast(theirs, 0);
+  if (theirs == bytes) return;
+  double end = 0.0;
+  std::memcpy(&end, theirs.data(), sizeof(double));
+  const bool same_text = theirs.size() == bytes.size() &&
+                         std::equal(bytes.begin() + sizeof(double), bytes.end(),
+                                    theirs.begin() + sizeof(double));
+  throw grbd::InvalidArgument(
+      scene_file + ": " +
+      (same_text ? "the end time " + grbd::format_number(scene.end_time) + " s differs from rank 0's, " +
+                       grbd::format_number(end) + " s"
+                 : std::string("the scene differs from the one rank 0 read")) +
+      ": every process of a run must be given the same scene and options");
+}
+
 int run_command(const std::string& scene_file, const std::optional<std::string>& output,
                 const std::optional<std::string>& checkpoint,
                 const std::optional<std::string>& restart,
                 const std::optional<std::string>& end_time,
                 const std::optional<std::string>& stop_file, bool force, bool quiet,
                 const std::string& progress) {
+  // A stop file touched after this moment asks this run to stop (one from before was left by
+  // an earlier run).
+  const auto run_started = std::filesystem::file_time_type::clock::now();
   // Under mpirun: MPI for the run, rank 0 speaks for every process (one progress display, one
   // summary, one message per error); each process exits with the same code.
   const grbd::parallel::MpiEnvironment mpi;
@@ -200,28 +234,35 @@ int run_command(const std::string& scene_file, const std::optional<std::string>&
   const bool speaker = world.rank() == 0;
   if (!speaker) quiet = true;
   std::ostream& errors = speaker ? std::cerr : null_stream();
+  // Every process reads the scene and the options, and every error is agreed, so that one
+  // process's (its own folder or command line under mpirun's MPMD syntax) ends them all with one
+  // message; a scene or end time that differs from rank 0's is such an error.
   grbd::scene::Scene scene;
   try {
-    scene = grbd::scene::load_scene(scene_file);
+    grbd::io::agree(world, [&] { scene = grbd::scene::load_scene(scene_file); });
   } catch (const grbd::Error& e) {
     errors << "grbd run: " << e.what() << '\n';
     return kExitInput;
   }
-  if (end_time) {
-    // The rules of the scene's key end_time: a decimal time > 0 of at most 10¹² steps.
-    try {
-      grbd::scene::set_end_time(scene, grbd::scene::parse_real(*end_time, "--end-time"),
-                                "--end-time");
-    } catch (const grbd::Error& e) {
-      errors << "grbd run: " << e.what() << '\n';
-      return kExitUsage;
-    }
+  try {
+    grbd::io::agree(world, [&] {
+      // The rules of the scene's key end_time: a decimal time > 0 of at most 10¹² steps.
+      if (end_time) {
+        grbd::scene::set_end_time(scene, grbd::scene::parse_real(*end_time, "--end-time"),
+                                  "--end-time");
+      }
+    });
+    grbd::io::agree(world, [&] { same_as_rank_0(world, scene, scene_file); });
+  } catch (const grbd::Error& e) {
+    errors << "grbd run: " << e.what() << '\n';
+    return kExitUsage;
   }
   grbd::io::RunOptions options;
   options.output = output ? std::filesystem::path(*output) : scene.output.file;
   options.checkpoint = checkpoint ? std::filesystem::path(*checkpoint) : scene.checkpoint.file;
   if (restart) options.restart = *restart;
   options.overwrite = force;
+  options.started = run_started;
   options.stop_file = stop_file ? std::filesystem::path(*stop_file)
                                 : std::filesystem::path(options.checkpoint.string() + ".stop");
   const bool bar = progress == "bar" || (progress == "auto" && isatty(STDERR_FILENO) != 0);
@@ -239,11 +280,14 @@ int run_command(const std::string& scene_file, const std::optional<std::string>&
   options.stop = &g_signal;
   grbd::io::RunResult result;
   try {
-    // One process takes exactly the serial path.
-    // A periodic scene runs on the parallel engine, also on one process.
-    result = world.size() > 1 || scene.domain.any_periodic()
-                 ? grbd::parallel::run(scene, options, world)
-                 : grbd::io::run(scene, options);
+    // One loop for any number of processes (io::run); a periodic scene, or more than one
+    // process, shares the scene with a parallel::SceneDecomposition.
+    result = grbd::parallel::run(scene, options, world);
+  } catch (const grbd::io::AbandonedFiles& e) {
+    // A write failed on some process: the parallel files cannot be closed together; end now.
+    display.finish();
+    errors << "grbd run: " << e.what() << '\n';
+    mpi.end_now(kExitFailed);
   } catch (const grbd::io::FileConflict& e) {
     errors << "grbd run: " << e.what() << '\n';
     return kExitUsage;
@@ -333,6 +377,44 @@ int info_command(const std::string& file) {
   }
 }
 
+// Why `csv` cannot take grbd chute's table ("" when it can): it is the output read, its XDMF or
+// the scene that made it, an existing file that is not a regular one (a folder, a device, a FIFO)
+// or not writable, or a name in a folder that does not exist. The CSV replaces only a regular file.
+std::string csv_problem(const std::string& csv, const std::string& output,
+                        const std::string& scene_file) {
+  namespace fs = std::filesystem;
+  const std::string quoted = '"' + csv + '"';
+  if (csv.empty()) return "expected a file name, found \"\"";
+  if (csv.find('\0') != std::string::npos) return quoted + ": the name contains a NUL character";
+  const std::pair<std::string, std::string> inputs[] = {
+      {output, "the output"},
+      {grbd::io::OutputFile::xdmf_path(output).string(), "the output's XDMF"},
+      {scene_file, "the scene"}};
+  for (const auto& [path, role] : inputs) {
+    if (!path.empty() && grbd::io::same_file(csv, path)) {
+      return quoted + " is " + role + " \"" + path + "\": it would be destroyed";
+    }
+  }
+  std::error_code error;
+  const fs::path target(csv);
+  const fs::path folder = target.has_parent_path() ? target.parent_path() : fs::path(".");
+  if (!fs::is_directory(folder, error)) {
+    return quoted + ": the folder \"" + folder.string() + "\" does not exist";
+  }
+  const auto status = fs::status(target, error);
+  if (fs::exists(status)) {
+    if (fs::is_directory(status)) return quoted + " is a folder: give a file name";
+    if (!fs::is_regular_file(status)) {
+      return quoted + " is not a regular file (a device, a FIFO or a socket): give a file name";
+    }
+    if (::access(csv.c_str(), W_OK) != 0) return quoted + " is read-only: it is not replaced";
+  }
+  if (::access(folder.c_str(), W_OK | X_OK) != 0) {
+    return quoted + ": the folder \"" + folder.string() + "\" is not writable";
+  }
+  return {};
+}
+
 // [chute command]
 // The chute study's measurements from an output (chapter 8): per record the flow count F — the
 // beads past the kink, those the outlet removed counted as past — and the front; then the times
@@ -350,6 +432,12 @@ int chute_command(const std::string& file, const std::optional<std::string>& csv
     const double beads = series.beads;
     const par::FlowTimes times = par::flow_times(t, count, beads, entry_count);
     if (csv) {
+      if (const std::string problem =
+              csv_problem(*csv, file, grbd::io::read_summary(file).scene_file);
+          !problem.empty()) {
+        std::cerr << "grbd chute: --csv " << problem << '\n';
+        return kExitUsage;
+      }
       // Written under a temporary name and renamed once complete: an earlier CSV stays whole.
       const std::filesystem::path temporary = *csv + ".tmp";
       {
@@ -554,6 +642,13 @@ int bench_command(const std::vector<std::string>& names, bool list,
 }  // namespace
 
 int grbd_main(int argc, char** argv) {
+  // Under mpirun every process runs this program: rank 0 alone speaks (a parse error, a missing
+  // file, validate's summary), one message per job; the others exit with the same code. A failing
+  // process of a run speaks for itself through parallel::abort_run().
+  if (grbd::parallel::launcher_rank() > 0) {
+    std::cout.rdbuf(nullptr);
+    std::cerr.rdbuf(nullptr);
+  }
   CLI::App app{"grbd: granular rigid body dynamics — run scenes, inspect their output"};
   app.footer(kExitCodes);
   app.set_version_flag("--version", std::string("grbd ") + GRBD_VERSION);
@@ -614,20 +709,26 @@ int grbd_main(int argc, char** argv) {
       ->required()
       ->check(CLI::ExistingFile);
   chute->add_option("--csv", chute_csv, "Also write t, bodies, flow count and front per record");
-  // CLI::Range lets NaN through (every comparison with it is false): a finite number first.
-  const CLI::Validator finite(
-      [](std::string& text) {
-        char* end = nullptr;
-        const double x = std::strtod(text.c_str(), &end);
-        return end != text.c_str() && *end == '\0' && std::isfinite(x)
-                   ? std::string()
-                   : "expected a finite number, found " + text;
-      },
-      "FINITE");
+  // The numbers of the scene files' rules (scene::parse_real: decimal, no hexadecimal, no
+  // spaces), finite and in range; the range named in plain words.
+  const auto real_in = [](bool (*in_range)(double), const std::string& range) {
+    return CLI::Validator(
+        [=](const std::string& text) -> std::string {
+          try {
+            const double x = grbd::scene::parse_real(text, "the value");
+            if (std::isfinite(x) && in_range(x)) return {};
+          } catch (const grbd::Error&) {
+          }
+          return "expected a decimal number " + range + ", found \"" + text + "\"";
+        },
+        "NUMBER");
+  };
   chute->add_option("--kink", chute_kink, "x of the kink [m], default -0.296 (the reference)")
-      ->check(finite & CLI::Range(-1e3, 1e3));
+      ->check(real_in([](double x) { return x >= -1e3 && x <= 1e3; },
+                      "in [-1000, 1000] m such as -0.296"));
   chute->add_option("--entry", chute_entry, "beads past the kink that mark the entry, default 150")
-      ->check(finite & CLI::PositiveNumber);
+      ->check(real_in([](double x) { return x >= 1.0 && x <= 1e15; },
+                      "of at least 1 (and at most 1e15) such as 150"));
   chute->footer(kChuteExitCodes);
 
   std::vector<std::string> fclib_inputs;

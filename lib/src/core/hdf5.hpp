@@ -64,6 +64,9 @@ class Handle {
     id_ = H5I_INVALID_HID;
     return ok;
   }
+  /// Forgets the object without closing it: what a collective file whose processes can no longer
+  /// close it together needs (the object stays open until the process ends).
+  void release() { id_ = H5I_INVALID_HID; }
 
  private:
   void reset() {

@@ -13,14 +13,14 @@
 #include "grbd/core/checks.hpp"
 #include "grbd/core/hash.hpp"
 
-#include "io/collective.hpp"
+#include "grbd/core/collectives.hpp"
 #include "io/h5util.hpp"
 
 namespace grbd::io {
 
 namespace {
 
-using collective::WarmRow;
+using timestep::WarmRow;
 using h5::check;
 using h5::Handle;
 
@@ -182,15 +182,15 @@ void write_temporary(const Communicator& comm, const std::filesystem::path& temp
     for (int d = 0; d < 3; ++d) warm[k].lambda[d] = s.warm_lambda[k][d];
   }
   if (comm.size() > 1) {
-    collective::sort_across(
+    grbd::collective::sort_across(
         comm, bodies, [](const timestep::PackedBody& row) { return timestep::packed_id(row); });
-    collective::sort_across(comm, warm, [](const WarmRow& w) { return w.key; });
+    grbd::collective::sort_across(comm, warm, [](const WarmRow& w) { return w.key; });
     warm.erase(std::unique(warm.begin(), warm.end(),
                            [](const WarmRow& a, const WarmRow& b) { return a.key == b.key; }),
                warm.end());
   }
-  const collective::Block body_block = collective::block_of(comm, bodies.size());
-  const collective::Block warm_block = collective::block_of(comm, warm.size());
+  const grbd::collective::Block body_block = grbd::collective::block_of(comm, bodies.size());
+  const grbd::collective::Block warm_block = grbd::collective::block_of(comm, warm.size());
   std::uint64_t rows[1] = {0};
   for (std::size_t i = 0; i < bodies.size(); ++i) {
     rows[0] += body_checksum(body_block.offset + i, bodies[i]);
@@ -277,8 +277,8 @@ void write_checkpoint(const Communicator& comm, const std::filesystem::path& pat
   const std::filesystem::path temporary = path.string() + ".tmp";
   const bool root = comm.rank() == 0;
   try {
-    collective::agree(comm, [&] { write_temporary(comm, temporary, checkpoint); });
-    collective::agree(comm, [&] {
+    agree(comm, [&] { write_temporary(comm, temporary, checkpoint); });
+    agree(comm, [&] {
       if (!root) return;
       sync_path(temporary, O_RDONLY);
       std::error_code error;
@@ -494,7 +494,7 @@ Checkpoint read_checkpoint(const std::filesystem::path& path) {
 // [read checkpoint]
 Checkpoint read_checkpoint(const Communicator& comm, const std::filesystem::path& path) {
   Part part;
-  collective::agree(comm, [&] { read_part(comm, path, part); });
+  agree(comm, [&] { read_part(comm, path, part); });
   Checkpoint& c = part.checkpoint;
   if (part.version >= 3) {
     // The sum over every process's slab: the same on every process, and so the same verdict.
@@ -520,7 +520,7 @@ Checkpoint read_checkpoint(const Communicator& comm, const std::filesystem::path
     part.first_body = lo;
     part.first_warm = wlo;
   }
-  collective::agree(
+  agree(
       comm, [&] { require_consistent(c, path.string(), part.first_body, part.first_warm); });
   return std::move(c);
 }

@@ -14,7 +14,7 @@
 #include <type_traits>
 
 #include "grbd/version.hpp"
-#include "io/collective.hpp"
+#include "grbd/core/collectives.hpp"
 #include "io/h5util.hpp"
 
 namespace grbd::io {
@@ -79,8 +79,13 @@ Handle open_output(const std::filesystem::path& path, unsigned mode, hid_t acces
   const std::string file = path.string();
   h5::require_regular_file(path, "grbd output file");
   if (H5Fis_hdf5(file.c_str()) <= 0) h5::fail(file, "is not an HDF5 file");
-  Handle handle = check(H5Fopen(file.c_str(), mode, access), H5Fclose, file,
-                        "cannot open the file (it may be damaged)");
+  const hid_t id = H5Fopen(file.c_str(), mode, access);
+  if (id < 0 && h5::locked_elsewhere(path)) {
+    h5::fail(file,
+             "is in use: a grbd run writes it, or another program has it open (HDF5's lock); read "
+             "it once the run has ended, or stop the run (its stop file) and read what it wrote");
+  }
+  Handle handle = check(id, H5Fclose, file, "cannot open the file (it may be damaged)");
   if (H5Aexists(handle.get(), "format") <= 0 ||
       h5::read_string(handle.get(), "format", file) != "grbd output") {
     h5::fail(file, "is not a grbd output file (attribute format is not \"grbd output\")");
@@ -267,7 +272,7 @@ OutputFile::OutputFile(const std::filesystem::path& path, const Communicator& co
   impl_->comm = &comm;
   impl_->path = path;
   impl_->file = path.string();
-  collective::agree(comm, [&] {
+  agree(comm, [&] {
     if (comm.rank() == 0) on_rank_0();
   });
   share();
@@ -297,7 +302,7 @@ void OutputFile::share() {
   o.contacts = (values[3] & 1) != 0;
   o.float32 = values[4] != 0;
   if ((values[3] & 2) == 0) throw IoError(o.file + ": cannot close the output file on rank 0");
-  collective::agree(comm, [&] {
+  agree(comm, [&] {
     o.handle = check(H5Fopen(o.file.c_str(), H5F_ACC_RDWR, h5::shared_access(comm, o.file).get()),
                      H5Fclose, o.file, "cannot open the output file on every process");
     const hid_t root = o.handle.get();
@@ -496,7 +501,7 @@ void OutputFile::write_bodies(std::vector<timestep::BodyRecord>& created) {
   h5::pack_rows(created, o.packed_bodies);
   created.clear();
   auto& rows = o.packed_bodies;
-  const collective::Block block = collective::sort_across(
+  const grbd::collective::Block block = grbd::collective::sort_across(
       *o.comm, rows, [](const timestep::PackedBody& row) { return timestep::packed_id(row); });
   if (block.total == 0) return;
   h5::resize(o.bodies.get(), written_.bodies + block.total, o.file, "bodies");
@@ -594,8 +599,8 @@ void OutputFile::write_record(double t, std::uint64_t step, RecordPart& part) {
   write_steps();
   // This process's block of the record: its rows of the global order by id.
   std::vector<RecordBody>& bodies = part.bodies;
-  const collective::Block block =
-      collective::sort_across(*o.comm, bodies, [](const RecordBody& b) { return b.id; });
+  const grbd::collective::Block block =
+      grbd::collective::sort_across(*o.comm, bodies, [](const RecordBody& b) { return b.id; });
   const std::size_t n = bodies.size();
   o.ids.resize(n);
   o.r.resize(3 * n);
@@ -677,8 +682,8 @@ std::uint64_t OutputFile::write_contacts(std::int64_t record,
                                          std::vector<RecordContact>& contacts) {
   static_assert(std::is_same_v<hid_t, std::int64_t>);
   Impl& o = *impl_;
-  const collective::Block block =
-      collective::sort_across(*o.comm, contacts, [](const RecordContact& c) { return c.key; });
+  const grbd::collective::Block block =
+      grbd::collective::sort_across(*o.comm, contacts, [](const RecordContact& c) { return c.key; });
   const std::size_t m = contacts.size();
   o.contact_ids.resize(2 * m);
   o.point.resize(3 * m);
@@ -731,6 +736,14 @@ std::uint64_t OutputFile::write_contacts(std::int64_t record,
   return M;
 }
 // [write contacts]
+
+void OutputFile::abandon() {
+  Impl& o = *impl_;
+  for (Handle* h : {&o.record_contacts, &o.record_bodies, &o.record_step, &o.record_time,
+                    &o.records, &o.steps, &o.bodies, &o.handle}) {
+    h->release();
+  }
+}
 
 void OutputFile::close(scene::Simulation& simulation) { close(simulation.created()); }
 

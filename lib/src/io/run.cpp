@@ -114,6 +114,28 @@ void check_run_files(const scene::Scene& scene, const RunOptions& options) {
       }
     }
   }
+  // The stop file is removed once it has done its work: it must be none of the run's files.
+  if (!options.stop_file.empty()) {
+    if (options.stop_file.native().find('\0') != std::string::npos) {
+      throw FileConflict("the stop file: the file name " + quoted(options.stop_file) +
+                         " contains a NUL character");
+    }
+    for (const std::vector<File>* files : {&written, &std::as_const(read)}) {
+      for (const File& f : *files) {
+        if (same_file(options.stop_file, f.path)) {
+          throw FileConflict("the stop file " + quoted(options.stop_file) + " is " + f.role + " " +
+                             quoted(f.path) + ": it would be removed when the run stops");
+        }
+      }
+    }
+    std::error_code error;
+    const auto status = fs::symlink_status(options.stop_file, error);
+    if (fs::exists(status) && !fs::is_regular_file(status)) {
+      throw FileConflict("the stop file " + quoted(options.stop_file) + " is " +
+                         (fs::is_directory(status) ? "a folder" : "not a regular file") +
+                         ": a stop file is a regular file that the run removes");
+    }
+  }
   for (const File& f : written) {
     std::error_code error;
     const fs::path folder = f.path.has_parent_path() ? f.path.parent_path() : fs::path(".");
@@ -156,11 +178,18 @@ bool stop_requested(const RunOptions& options) {
 
 void remove_stop_file(const RunOptions& options) {
   std::error_code error;
-  std::filesystem::remove(options.stop_file, error);
+  if (std::filesystem::is_regular_file(std::filesystem::symlink_status(options.stop_file, error))) {
+    std::filesystem::remove(options.stop_file, error);
+  }
 }
 
 void clear_stale_stop_file(const RunOptions& options) {
   if (!stop_requested(options)) return;
+  // A stop file touched since the run began asks this run to stop; an older one was left by a
+  // run that was killed before it could remove it.
+  std::error_code error;
+  const auto touched = std::filesystem::last_write_time(options.stop_file, error);
+  if (!error && touched >= options.started) return;
   remove_stop_file(options);
   if (options.on_warning) {
     options.on_warning(options.stop_file.string() +
@@ -183,103 +212,162 @@ std::unique_ptr<scene::Simulation> restored_simulation(const scene::Scene& scene
 }
 
 RunResult run(const scene::Scene& scene, const RunOptions& options) {
+  return run(scene, options, self_communicator(), {});
+}
+
+// [run loop]
+RunResult run(const scene::Scene& scene, const RunOptions& options, const Communicator& comm,
+              const MakeDistribution& make_distribution) {
   const auto start = std::chrono::steady_clock::now();
-  check_run_files(scene, options);
-  clear_stale_stop_file(options);
+  const bool root = comm.rank() == 0;
+  if (!make_distribution && comm.size() > 1) {
+    throw InvalidArgument("io::run: a run on " + std::to_string(comm.size()) +
+                          " processes needs a distribution of the scene (parallel::run)");
+  }
+  // Rank 0 checks the files and looks for a stale stop file; every process learns the verdict.
+  agree(comm, [&] {
+    if (!root) return;
+    check_run_files(scene, options);
+    clear_stale_stop_file(options);
+  });
+  std::unique_ptr<scene::Distribution> distribution;
+  agree(comm, [&] {
+    if (make_distribution) distribution = make_distribution();
+  });
   RunResult result;
   std::unique_ptr<scene::Simulation> simulation;
   std::unique_ptr<OutputFile> output;
   if (options.restart) {
-    const Checkpoint checkpoint = read_checkpoint(*options.restart);
+    Checkpoint checkpoint;
+    agree(comm, [&] { checkpoint = read_checkpoint(comm, *options.restart); });
     if (const std::string difference =
             scene_difference(checkpoint.scene_text, scene.text, scene.file);
-        !difference.empty() && options.on_warning) {
+        root && !difference.empty() && options.on_warning) {
       options.on_warning(difference);
     }
-    simulation = restored_simulation(scene, checkpoint, *options.restart, nullptr);
-    std::error_code error;
-    if (std::filesystem::exists(options.output, error)) {
-      output =
-          std::make_unique<OutputFile>(options.output, scene, checkpoint.output,
-                                       RunIdentity{checkpoint.scene_text, checkpoint.state.bodies});
-    } else {
+    if (distribution) distribution->redistribute(checkpoint.state);
+    agree(comm, [&] {
+      simulation = restored_simulation(scene, checkpoint, *options.restart, distribution.get());
+    });
+    // Whether the output exists, as rank 0 sees it.
+    std::vector<std::byte> exists(1, std::byte{0});
+    if (root) {
+      std::error_code error;
+      exists[0] = static_cast<std::byte>(std::filesystem::exists(options.output, error));
+    }
+    comm.broadcast(exists, 0);
+    if (exists[0] == std::byte{0}) {
       // A new output: its body table starts with every body of the checkpoint.
-      output = std::make_unique<OutputFile>(options.output, scene);
       for (std::size_t i = 0; i < simulation->system().owned_count(); ++i) {
         simulation->created().push_back(simulation->system().record(i));
       }
     }
+    // Rank 0 checks that an output it reopens is this run's, with the bodies the checkpoint holds.
+    agree(comm, [&] {
+      output = exists[0] != std::byte{0}
+                   ? std::make_unique<OutputFile>(
+                         options.output, scene, checkpoint.output,
+                         RunIdentity{checkpoint.scene_text, checkpoint.state.bodies}, comm)
+                   : std::make_unique<OutputFile>(options.output, scene, comm);
+    });
   } else {
-    simulation = std::make_unique<scene::Simulation>(scene);
-    output = std::make_unique<OutputFile>(options.output, scene);
-    output->write_record(*simulation);
+    agree(comm, [&] {
+      simulation = distribution ? std::make_unique<scene::Simulation>(scene, nullptr, *distribution)
+                                : std::make_unique<scene::Simulation>(scene);
+    });
+    agree(comm, [&] { output = std::make_unique<OutputFile>(options.output, scene, comm); });
   }
   scene::Simulation& sim = *simulation;
+  // A write that failed on some process leaves the processes' parallel HDF5 state apart: the
+  // file cannot be closed together any more (OutputFile::abandon), and the error says so.
+  const auto written = [&](auto&& work) {
+    try {
+      agree(comm, work);
+    } catch (const Error& e) {
+      if (comm.size() == 1) throw;
+      output->abandon();
+      throw AbandonedFiles(e.what());
+    }
+  };
+  const auto write_record = [&] {
+    const auto t0 = std::chrono::steady_clock::now();
+    written([&] { output->write_record(sim); });
+    result.output_seconds += seconds_since(t0);
+  };
+  if (!options.restart) write_record();
   const std::uint64_t every = scene.output.every;
   const std::uint64_t checkpoint_every = scene.checkpoint.every;
   std::uint64_t saved_at = ~std::uint64_t{0};
-  auto save = [&] {
+  const auto save = [&] {
     if (saved_at == sim.stepper().steps()) return;
     saved_at = sim.stepper().steps();
     const auto t0 = std::chrono::steady_clock::now();
-    output->flush(sim);
-    Checkpoint checkpoint{sim.save(), output->position(), scene.text};
-    write_checkpoint(options.checkpoint, checkpoint);
+    written([&] {
+      output->flush(sim);
+      write_checkpoint(comm, options.checkpoint,
+                       Checkpoint{sim.save(), output->position(), scene.text});
+    });
     ++result.checkpoints;
     result.output_seconds += seconds_since(t0);
   };
   // Whether the current state is the last record: a fresh run has just written it; a restart has
   // it when the checkpoint's step is on the record grid (an extra last record was dropped).
   bool recorded = !options.restart || (every > 0 && sim.stepper().steps() % every == 0);
-  try {
-    while (!sim.finished()) {
-      if (options.stop != nullptr && *options.stop != 0) {
-        result.interrupted = true;
-        break;
-      }
-      if (stop_requested(options)) {
-        result.interrupted = result.stop_file = true;
-        break;
-      }
-      const auto t0 = std::chrono::steady_clock::now();
-      const timestep::StepReport report = sim.step();
-      result.step_seconds += seconds_since(t0);
-      ++result.steps;
-      output->add_step(report, sim.system().size());
-      recorded = false;
-      const std::uint64_t step = sim.stepper().steps();
-      if (every > 0 && step % every == 0) {
-        const auto t1 = std::chrono::steady_clock::now();
-        output->write_record(sim);
-        result.output_seconds += seconds_since(t1);
-        recorded = true;
-      }
-      if (checkpoint_every > 0 && step % checkpoint_every == 0) save();
-      if (options.on_step) options.on_step(sim, report, sim.system().size());
+  while (!sim.finished()) {
+    // [agreed stop]
+    // The stop, agreed by every process at a step boundary: a signal on any process, or the
+    // stop file, which rank 0 looks for.
+    const bool by_file = root && stop_requested(options);
+    const bool by_signal = options.stop != nullptr && *options.stop != 0;
+    std::vector<double> stops{by_file || by_signal ? 1.0 : 0.0, by_file ? 1.0 : 0.0};
+    comm.max(stops);
+    if (stops[0] > 0.0) {
+      result.interrupted = true;
+      result.stop_file = stops[1] > 0.0;
+      break;
     }
-  } catch (...) {
-    // A failed step (a blow-up, a diverged solver) leaves a state that is not data: no record,
-    // no checkpoint of it. The rows of the steps before it are kept, and the file is closed;
-    // a write that failed may fail again here, and then the first error is the one reported.
+    // [agreed stop]
+    const auto t0 = std::chrono::steady_clock::now();
+    timestep::StepReport report;
     try {
-      output->close(sim);
-    } catch (const Error&) {
+      // A step that fails on one process while the others wait in its exchanges ends every
+      // process after the agreement's patience (Communicator::agree).
+      agree(comm, [&] { report = sim.step(); });
+    } catch (...) {
+      // A failed step (a blow-up, a diverged solver) leaves a state that is not data: no record,
+      // no checkpoint of it. The rows of the steps before it are kept, and the file is closed;
+      // a write that failed may fail again here, and then the first error is the one reported.
+      try {
+        agree(comm, [&] { output->close(sim); });
+      } catch (const Error&) {
+      }
+      throw;
     }
-    throw;
+    result.step_seconds += seconds_since(t0);
+    ++result.steps;
+    std::uint64_t bodies[1] = {sim.system().owned_count()};
+    comm.sum(bodies);
+    output->add_step(report, bodies[0]);
+    recorded = false;
+    const std::uint64_t step = sim.stepper().steps();
+    if (every > 0 && step % every == 0) {
+      write_record();
+      recorded = true;
+    }
+    if (checkpoint_every > 0 && step % checkpoint_every == 0) save();
+    if (root && options.on_step) options.on_step(sim, report, bodies[0]);
   }
   // The checkpoint first: the extra last record (not on the regular grid) is not part of what a
   // restart continues from, so that it gives the same records as an uninterrupted run.
   save();
-  if (!recorded && !result.interrupted) {
-    const auto t1 = std::chrono::steady_clock::now();
-    output->write_record(sim);
-    result.output_seconds += seconds_since(t1);
-  }
-  output->close(sim);
-  if (result.stop_file) remove_stop_file(options);
+  if (!recorded && !result.interrupted) write_record();
+  written([&] { output->close(sim); });
+  if (root && result.stop_file) remove_stop_file(options);
   result.records = output->position().records;
+  result.rebalances = distribution ? distribution->rebalances() : 0;
   result.seconds = seconds_since(start);
   return result;
 }
+// [run loop]
 
 }  // namespace grbd::io

@@ -12,6 +12,7 @@
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
+#include <iostream>
 #include <limits>
 #include <string>
 #include <thread>
@@ -52,13 +53,29 @@ bool launched_by_mpi() {
   return false;
 }
 
+int launcher_rank() {
+  for (const char* name : {"OMPI_COMM_WORLD_RANK", "PMIX_RANK", "PMI_RANK"}) {
+    if (const char* value = std::getenv(name); value != nullptr) {
+      char* end = nullptr;
+      const long rank = std::strtol(value, &end, 10);
+      if (end != value && *end == '\0' && rank >= 0) return static_cast<int>(rank);
+    }
+  }
+  return 0;
+}
+
 struct MpiCommunicator::Impl {
   MPI_Comm comm = MPI_COMM_NULL;
+  // The agreement's own communicator: a process that failed agrees there while the others may
+  // still wait in a collective operation of `comm` (a step's reduction), which a reduction of the
+  // agreement on `comm` would be matched with.
+  MPI_Comm agreement = MPI_COMM_NULL;
 };
 
 MpiCommunicator::MpiCommunicator() : impl_(std::make_unique<Impl>()) {
   check(MPI_Comm_dup(MPI_COMM_WORLD, &impl_->comm), "MPI_Comm_dup");
   check(MPI_Comm_set_errhandler(impl_->comm, MPI_ERRORS_RETURN), "MPI_Comm_set_errhandler");
+  check(MPI_Comm_dup(impl_->comm, &impl_->agreement), "MPI_Comm_dup");
   check(MPI_Comm_rank(impl_->comm, &rank_), "MPI_Comm_rank");
   check(MPI_Comm_size(impl_->comm, &size_), "MPI_Comm_size");
 }
@@ -66,7 +83,9 @@ MpiCommunicator::MpiCommunicator() : impl_(std::make_unique<Impl>()) {
 MpiCommunicator::~MpiCommunicator() {
   int finalized = 0;
   MPI_Finalized(&finalized);
-  if (!finalized && impl_->comm != MPI_COMM_NULL) MPI_Comm_free(&impl_->comm);
+  if (finalized) return;
+  if (impl_->agreement != MPI_COMM_NULL) MPI_Comm_free(&impl_->agreement);
+  if (impl_->comm != MPI_COMM_NULL) MPI_Comm_free(&impl_->comm);
 }
 
 int MpiCommunicator::rank() const { return rank_; }
@@ -124,7 +143,7 @@ bool MpiCommunicator::agree(bool ok, const std::string& error, double patience) 
   int flag = ok ? 1 : 0;
   int result = 0;
   MPI_Request request = MPI_REQUEST_NULL;
-  check(MPI_Iallreduce(&flag, &result, 1, MPI_INT, MPI_LAND, impl_->comm, &request),
+  check(MPI_Iallreduce(&flag, &result, 1, MPI_INT, MPI_LAND, impl_->agreement, &request),
         "MPI_Iallreduce (agree)");
   if (ok) {
     check(MPI_Wait(&request, MPI_STATUS_IGNORE), "MPI_Wait (agree)");
@@ -291,6 +310,13 @@ MpiEnvironment::~MpiEnvironment() {
     MPI_Finalize();
   }
   the_environment = nullptr;
+}
+
+void MpiEnvironment::end_now(int exit_code) const {
+  std::cout.flush();
+  std::cerr.flush();
+  std::fflush(nullptr);
+  std::_Exit(exit_code);
 }
 
 const Communicator& MpiEnvironment::world() const {

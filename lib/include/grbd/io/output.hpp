@@ -33,6 +33,7 @@
 #include <string_view>
 #include <vector>
 
+#include "grbd/core/agreement.hpp"
 #include "grbd/core/communicator.hpp"
 #include "grbd/core/error.hpp"
 #include "grbd/scene/simulation.hpp"
@@ -46,6 +47,24 @@ class IoError : public Error {
  public:
   using Error::Error;
 };
+
+/// A run's files that coincide (the output, its XDMF, the checkpoint, their temporary names, the
+/// scene, its meshes, the restart checkpoint and the stop file must be different files), or a
+/// file name with a NUL character: a bad command line (`grbd run` exits 2).
+class FileConflict : public IoError {
+ public:
+  using IoError::IoError;
+};
+
+/// grbd::run_agreed() with the kinds of error that the phases of a run tell apart, because the kind
+/// decides the command line's exit code: every process throws the FileConflict, IoError,
+/// scene::SceneError, scene::StateError or InvalidArgument that the lowest failing rank met
+/// (collective; at one process the work runs and its error propagates as thrown).
+template <class Work>
+void agree(const Communicator& comm, Work&& work) {
+  grbd::run_agreed<FileConflict, IoError, scene::SceneError, scene::StateError, InvalidArgument>(
+      comm, std::forward<Work>(work));
+}
 
 /// How much of an output file was written: rows of /records, /steps and /bodies. A checkpoint
 /// keeps it, so that a restart can drop what was written after the checkpoint.
@@ -171,6 +190,11 @@ class OutputFile {
   void close(scene::Simulation& simulation);
   /// The same with the bodies created (as flush()).
   void close(std::vector<timestep::BodyRecord>& created);
+  /// Leaves the file as its last flush made it, without closing it: after a write that failed on
+  /// some process of a parallel run, the processes can no longer close it together (HDF5's
+  /// collective close would wait for ever or crash). The file holds every record counted; the
+  /// program must then end without finalizing MPI (io::AbandonedFiles).
+  void abandon();
   /// The XDMF file written beside `path`.
   static std::filesystem::path xdmf_path(const std::filesystem::path& path);
 

@@ -34,9 +34,12 @@ struct RunOptions {
   /// job on a cluster touches before its time is up, when a signal to mpirun might not leave the
   /// processes time enough to finish. Empty: none.
   std::filesystem::path stop_file;
+  /// When the run began (the command line's start): a stop file older than this was left by an
+  /// earlier run and is removed at the start; a newer one asks this run to stop.
+  std::filesystem::file_time_type started = std::filesystem::file_time_type::clock::now();
   /// Called after every step (progress display) with the simulation, the step's report and the
-  /// number of bodies of the run. In a parallel run it is called on rank 0 only, whose simulation
-  /// holds its own bodies; the report and the number are the whole run's.
+  /// number of bodies of the run, on every process of a parallel run: the simulation holds the
+  /// process's own bodies, the report and the number are the whole run's.
   std::function<void(const scene::Simulation&, const timestep::StepReport&, std::uint64_t)> on_step;
   /// Called with a warning the run goes on after: a restart whose scene text differs from the
   /// checkpoint's (the first line that differs). Without it, warnings are not reported.
@@ -48,20 +51,13 @@ struct RunOptions {
 std::string scene_difference(const std::string& saved, const std::string& given,
                              const std::filesystem::path& scene_file);
 
-/// A run's files that coincide (the output, its XDMF, the checkpoint, their temporary names, the
-/// scene, its meshes and the restart checkpoint must be different files), or a file name with a
-/// NUL character: a bad command line (`grbd run` exits 2).
-class FileConflict : public IoError {
- public:
-  using IoError::IoError;
-};
-
 /// Whether two paths name the same file: the same device and inode when both exist (other
 /// spellings, links), else the same canonical path.
 bool same_file(const std::filesystem::path& a, const std::filesystem::path& b);
 
 /// Checks a run's files before anything is read, built or written: FileConflict for files that
-/// coincide or a NUL in a name; IoError naming the file for an output or checkpoint whose folder
+/// coincide (the stop file included: it may be none of the others, and must be a regular file
+/// when it exists) or a NUL in a name; IoError naming the file for an output or checkpoint whose folder
 /// does not exist or cannot be written, a name that is a folder or not a regular file, an output
 /// that another process holds open, and, on a fresh run without `overwrite`, an output, XDMF or
 /// checkpoint that exists already. run() calls it first.
@@ -69,10 +65,12 @@ void check_run_files(const scene::Scene& scene, const RunOptions& options);
 
 /// Whether options.stop_file exists (the run is asked to stop).
 bool stop_requested(const RunOptions& options);
-/// Removes options.stop_file once the stop it asked for is done (a missing file is no error).
+/// Removes options.stop_file once the stop it asked for is done, if it is a regular file (a
+/// missing file is no error).
 void remove_stop_file(const RunOptions& options);
-/// Removes a stop file that is there before the run starts (an earlier run was killed before it
-/// could remove it), with a warning through options.on_warning.
+/// Removes a stop file last written before options.started (an earlier run was killed before it
+/// could remove it), with a warning through options.on_warning; a newer one stays and stops the
+/// run at its first step boundary.
 void clear_stale_stop_file(const RunOptions& options);
 
 /// The simulation a restart continues: `scene` built from `checkpoint`'s state (with
@@ -97,15 +95,46 @@ struct RunResult {
   std::uint64_t rebalances = 0;
 };
 
-/// Runs `scene` to its end_time (or until *stop): a record at step 0 (fresh runs), every
-/// output.every steps and at the end; a checkpoint every checkpoint.every steps and at the end
-/// (before the last record when that is not a regular one, so that a restart from it gives the
-/// same records as an uninterrupted run). Throws FileConflict, SceneError or IoError for bad
-/// input before the first step (nothing changed: an existing output is truncated or cut back only
-/// after every check passed), IoError naming the restart checkpoint for one that does not fit the
-/// scene, and grbd::Error when a step fails (a blow-up, a diverged solver, a write that failed):
-/// the output then holds every record and step row before the failure, and the last checkpoint is
-/// the last valid state.
+/// Runs `scene` to its end_time (or until *stop) on one process: run() with the one-process
+/// communicator and no distribution.
 RunResult run(const scene::Scene& scene, const RunOptions& options);
+
+/// Makes the distribution of a scene among the processes of a run (parallel::run gives
+/// parallel::SceneDecomposition); it may throw SceneError for a scene it cannot share.
+using MakeDistribution = std::function<std::unique_ptr<scene::Distribution>()>;
+
+/// A write of the output or of a checkpoint failed on some process of a parallel run: their
+/// parallel HDF5 state is apart, so the files cannot be closed together any more. The output
+/// holds every record counted before the failure, the last checkpoint is whole; the program must
+/// end without closing HDF5 or finalizing MPI (parallel::MpiEnvironment::end_now), or it would
+/// hang or crash in HDF5's collective clean-up.
+class AbandonedFiles : public IoError {
+ public:
+  using IoError::IoError;
+};
+
+/// Runs `scene` to its end_time (or until *stop) on every process of `comm` (collective), the one
+/// loop of every run, serial or parallel: a record at step 0 (fresh runs), every output.every
+/// steps and at the end; a checkpoint every checkpoint.every steps and at the end (before the last
+/// record when that is not a regular one, so that a restart from it gives the same records as an
+/// uninterrupted run). `make_distribution` shares the scene among the processes (empty: the
+/// serial engine, which needs one process).
+///
+/// Every phase that can fail on one process — the files' checks, the distribution, reading the
+/// checkpoint, building the simulation, opening the output, each step, each record, each
+/// checkpoint, the close — is agreed (io::agree): every process throws the same error. Throws
+/// FileConflict, SceneError or IoError for bad input before the first step (nothing changed: an
+/// existing output is truncated or cut back only after every check passed), IoError naming the
+/// restart checkpoint for one that does not fit the scene, grbd::Error when a step fails (a
+/// blow-up, a diverged solver: the output then holds every record and step row before the
+/// failure, and the last checkpoint is the last valid state), and AbandonedFiles when a write
+/// failed on many processes. A step that fails on one process while the others wait in its
+/// exchanges ends every process after kAgreementPatience (Communicator::agree).
+///
+/// The stop (options.stop, set by a signal on any process, or the stop file, which rank 0 looks
+/// for) is agreed at every step boundary: every process stops there, and the run writes its
+/// checkpoint and returns. Warnings are given on rank 0 only; options.on_step on every process.
+RunResult run(const scene::Scene& scene, const RunOptions& options, const Communicator& comm,
+              const MakeDistribution& make_distribution);
 
 }  // namespace grbd::io

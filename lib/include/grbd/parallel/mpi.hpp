@@ -18,6 +18,11 @@ namespace grbd::parallel {
 /// and never initialises MPI.
 bool launched_by_mpi();
 
+/// This process's rank as the MPI launcher's environment gives it (0 when not launched by MPI),
+/// known before MPI is initialised: the commands that run no MPI of their own speak on rank 0
+/// only, one message per job.
+int launcher_rank();
+
 /// The communicator of every process of the run, MPI_COMM_WORLD (or a duplicate of a given
 /// communicator). Collective operations as grbd::Communicator promises; a failing MPI call ends
 /// every process through abort_run().
@@ -71,6 +76,11 @@ class MpiEnvironment {
   bool active() const { return world_ != nullptr; }
   /// All processes of the run (the one-process communicator without MPI).
   const Communicator& world() const;
+  /// Ends this process now with `exit_code`, its output streams flushed, without finalizing MPI
+  /// or closing HDF5: what every process of a run does after a collective write failed
+  /// (io::AbandonedFiles), where HDF5's collective clean-up inside MPI_Finalize would hang or
+  /// crash. The files hold what their last flush wrote.
+  [[noreturn]] void end_now(int exit_code) const;
 
  private:
   std::unique_ptr<MpiCommunicator> world_;

@@ -51,7 +51,13 @@ class SceneDecomposition final : public scene::Distribution {
                                             const timestep::MaterialTable& materials,
                                             const timestep::StepSettings& settings) const override;
   /// How often the last engine made rebalanced its partition (0 before there is one).
-  std::uint64_t rebalances() const { return engine_ != nullptr ? engine_->rebalances() : 0; }
+  std::uint64_t rebalances() const override {
+    return engine_ != nullptr ? engine_->rebalances() : 0;
+  }
+  /// After a restart read in slabs (io::read_checkpoint): every body goes to the process that
+  /// owns its centre, every warm start to the one that solves its contact (solves_contact()), in
+  /// three exchanges among all processes, each of O(N/P) rows (collective).
+  void redistribute(scene::SimulationState& state) const override;
   /// The partition the run starts from.
   const Partition& partition() const { return *partition_; }
   /// The parallel step's settings (largest bounding radius of the scene's groups).
@@ -66,20 +72,16 @@ class SceneDecomposition final : public scene::Distribution {
   mutable const ParallelStepper* engine_ = nullptr;  // the last engine made
 };
 
-/// io::run() on every process of `comm` (collective): the same checks, records, checkpoints and
-/// restart, and the same files, written by rank 0 from the parts every process sends it (records
-/// with their bodies in ascending id, contacts by key; checkpoints with the bodies in ascending id
-/// and the warm starts by key, so that any number of processes can continue from them).
-///
-/// An error that every process sees alike or that one process finds before the first step or
-/// while writing (bad files, a scene or checkpoint that does not fit) is thrown on every process
-/// with the message of the lowest rank that found it, as the same kind of grbd::Error. A step
-/// that fails on some process (a blow-up, a diverged solver) ends every process through
-/// abort_run() with exit code 1, the output holding every record before it.
-///
-/// The stop (options.stop, set by a signal) is agreed at every step boundary: when it is set on
-/// any process, every process stops there, and the run writes its checkpoint and returns.
-/// Progress (options.on_step) and warnings are given on rank 0 only.
+/// Whether a run of `scene` on `comm` needs a SceneDecomposition: on more than one process, or
+/// with a periodic axis (its images are ghosts, also on one process). Otherwise the run steps with
+/// chapter 6's stepper alone.
+bool needs_decomposition(const scene::Scene& scene, const Communicator& comm);
+
+/// `grbd run` on every process of `comm` (collective): io::run(), the one run loop, with a
+/// SceneDecomposition when needs_decomposition() — the same checks, records, checkpoints and
+/// restart, the records with their bodies in ascending id and contacts by key, checkpoints with
+/// the bodies in ascending id and the warm starts by key, so that any number of processes can
+/// continue from them. Every error is agreed: one process's is thrown on every process.
 io::RunResult run(const scene::Scene& scene, const io::RunOptions& options,
                   const Communicator& comm);
 

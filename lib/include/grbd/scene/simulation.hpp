@@ -80,6 +80,11 @@ class Distribution {
                                              const timestep::StaticGeometry& statics,
                                              const timestep::MaterialTable& materials,
                                              const timestep::StepSettings& settings) const = 0;
+  /// Gives every body of a restart's `state`, read by each process in slabs, to the process that
+  /// owns it, and every warm start to the process that solves its contact (collective).
+  virtual void redistribute(SimulationState& state) const = 0;
+  /// How often the engine re-cut the domain to even the load so far.
+  virtual std::uint64_t rebalances() const = 0;
 };
 
 /// A runnable scene. Construction generates the initial bodies (list, lattice and packing

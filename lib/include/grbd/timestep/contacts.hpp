@@ -35,6 +35,13 @@ struct ContactKey {
   friend auto operator<=>(const ContactKey&, const ContactKey&) = default;
 };
 
+/// A warm start as a row of a checkpoint or of a message between processes: its contact's key and
+/// percussion (trivially copyable).
+struct WarmRow {
+  ContactKey key;    ///< the contact
+  double lambda[3];  ///< its percussion Λ [N s]
+};
+
 /// A contact as detection finds it: the two sides as the contact problem sees them, their
 /// materials, and the geometry at the detected states (normal from b towards a, gap, the two
 /// closest points, features), and the rows of the two sides in the BodySystem. 120 bytes: no

@@ -1,30 +1,29 @@
 #pragma once
-// What the output and the checkpoints need to be written by many processes at once (chapter 8;
-// private to the library): rows put into one global order across the processes (a sample sort),
-// so that each process writes one contiguous block of a dataset, and the agreement on an error
-// that only some processes meet while they read or write a file.
+/// \file
+/// \brief Collective operations over rows (chapter 8), built on the Communicator: where each
+/// process's rows lie in a global order (an exclusive scan), one message to every process, the rows
+/// of received messages, and a sample sort across the processes — what the output, the
+/// checkpoints and the parallel engine need to write and move rows among many processes.
 
 #include <algorithm>
 #include <cstdint>
 #include <cstring>
-#include <exception>
-#include <new>
 #include <span>
-#include <string>
 #include <type_traits>
 #include <vector>
 
 #include "grbd/core/communicator.hpp"
-#include "grbd/io/output.hpp"
-#include "grbd/timestep/contacts.hpp"
 
-namespace grbd::io::collective {
+namespace grbd::collective {
 
-/// A warm start as a row of a checkpoint or of a message: its contact's key and percussion.
-struct WarmRow {
-  timestep::ContactKey key;  ///< the contact
-  double lambda[3];          ///< its percussion Λ [N s]
-};
+/// Appends a trivially copyable row to a message.
+template <class Row>
+void put(std::vector<std::byte>& out, const Row& row) {
+  static_assert(std::is_trivially_copyable_v<Row>);
+  const std::size_t at = out.size();
+  out.resize(at + sizeof(Row));
+  std::memcpy(out.data() + at, &row, sizeof(Row));
+}
 
 /// Where this process's rows lie in the global order: rows [offset, offset + n) of `total`.
 struct Block {
@@ -143,38 +142,4 @@ Block sort_across(const Communicator& comm, std::vector<Row>& rows, KeyOf key_of
 }
 // [sort across]
 
-/// Runs `work` on every process; when it throws on some, every process throws IoError with the
-/// message of the lowest rank that failed (collective): what a file read or written by every
-/// process needs, where one process may find a damaged row that the others never see. Without
-/// an error, every process returns.
-template <class Work>
-void agree(const Communicator& comm, Work&& work) {
-  if (comm.size() == 1) {
-    work();
-    return;
-  }
-  std::string message;
-  bool failed = false;
-  try {
-    work();
-  } catch (const std::bad_alloc&) {
-    failed = true;
-    message = "out of memory";
-  } catch (const std::exception& e) {
-    failed = true;
-    message = e.what();
-  }
-  // A process that failed inside a collective call of parallel HDF5 has left the others waiting
-  // in it: after kAgreementPatience it ends the run with its message rather than wait forever.
-  if (comm.agree(!failed, message, kAgreementPatience)) return;
-  std::vector<std::vector<std::byte>> all;
-  std::vector<std::byte> mine(failed ? message.size() + 1 : 0);
-  if (failed) std::memcpy(mine.data(), message.data(), message.size());
-  comm.all_gather(mine, all);
-  for (const std::vector<std::byte>& part : all) {
-    if (part.empty()) continue;
-    throw IoError(std::string(reinterpret_cast<const char*>(part.data()), part.size() - 1));
-  }
-}
-
-}  // namespace grbd::io::collective
+}  // namespace grbd::collective
