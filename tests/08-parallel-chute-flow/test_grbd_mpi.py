@@ -123,8 +123,10 @@ class BitIdentical(Runs):
                     self.assertAlmostEqual(value, attrs[key], delta=1e-13 * value)
                 else:
                     self.assertEqual(value, attrs[key], f"P = {p}: checkpoint attribute {key}")
-        # Written collectively in the global order of ids, the checkpoint is the same file whatever
-        # the number of processes: its checksum (over every row, in order) included.
+        # Written collectively in the global order of ids, the checkpoint's state is the same
+        # whatever the number of processes: its checksum (over every row, in order) included. The
+        # cuts its processes stepped on are kept beside it (dataset distribution), with their own
+        # checksum.
         checksums = set()
         for p in (2, 3, 4):
             with h5py.File(self.path(f"p{p}.c.h5"), "r") as f:
@@ -551,11 +553,19 @@ class Incline(Runs):
                 # At 24° the layer flows (glass beads stop below about 21°): downstream, and
                 # never backwards.
                 self.assertGreater(mean, 0.02, f"P = {p}")
-                speeds.append(mean)
+                # The speed over the second half of the run: one record's speed wanders by ±50 %
+                # from run to run once the flow has begun (0.033-0.10 m/s at 0.3 s on 2 and 3
+                # processes with balances every 25 or 50 steps), its mean over the second half
+                # by ±25 %.
+                speeds.append(float(np.mean([
+                    f[f"records/{k:06d}/I_v_S"][()][
+                        ~np.isin(f[f"records/{k:06d}/id"][()], base), 0].mean()
+                    for k in range(n // 2, n)])))
                 heights.append(float(x[~on_base, 2].mean()))
-        # Two or three processes do not step bit for bit as one (contacts solved in another order,
-        # split beads averaged), and the onset of a flow amplifies the difference: the layers
-        # settle to the same height to 2 %, and start to flow at the same speed to 30 %.
+        # Two or three processes that balance their loads do not step bit for bit as one
+        # (contacts solved in another order, split beads averaged), and the onset of a flow
+        # amplifies the difference: the layers settle to the same height to 2 %, and flow at the
+        # same mean speed to 30 %.
         for height, speed in zip(heights[1:], speeds[1:]):
             self.assertLess(abs(height - heights[0]), 0.02 * heights[0], heights)
             self.assertLess(abs(speed - speeds[0]), 0.3 * speeds[0], speeds)

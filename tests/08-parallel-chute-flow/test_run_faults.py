@@ -196,6 +196,33 @@ class Faults(unittest.TestCase):
                           self.path(f"r{p}.h5"), "-r", ckpt, "--end-time", "0.01")
             self.assertEqual(result.returncode, 0, result.stderr)
 
+    def test_a_restart_on_as_many_processes_continues_the_run_bit_for_bit_after_balances(self):
+        # The balance looks at the load every 50 steps and moves the cuts (the default table);
+        # the checkpoint at step 60 keeps them, and every checkpoint leaves each body with its
+        # owner, so that the restart steps as the run goes on.
+        with open(self.scene) as f:
+            text = f.read()
+        scene = self.path("b.toml")
+        with open(scene, "w") as f:
+            f.write(text + "\n[parallel]\nrebalance_every = 50\nimbalance = 1.05\n")
+        for p in (2, 3):
+            ref, out, ckpt = self.path(f"ref{p}.h5"), self.path(f"s{p}.h5"), self.path(f"s{p}.c.h5")
+            result = grbd(p, "run", scene, "-o", ref, "-c", self.path(f"ref{p}.c.h5"))
+            self.assertEqual(result.returncode, 0, result.stderr)
+            self.assertRegex(result.stdout, r"[1-9]\d* rebalances", "nothing was tested")
+            for args in (["--end-time", "0.012"], ["-r", ckpt]):
+                result = grbd(p, "run", scene, "-q", "-o", out, "-c", ckpt, *args)
+                self.assertEqual(result.returncode, 0, result.stderr)
+            with h5py.File(ref, "r") as a, h5py.File(out, "r") as b:
+                count = int(a["records"].attrs["count"])
+                self.assertEqual(int(b["records"].attrs["count"]), count)
+                for k in range(count):
+                    for name in ("id", "I_r_S", "p", "I_v_S", "K_omega"):
+                        path = f"records/{k:06d}/{name}"
+                        self.assertTrue((a[path][()] == b[path][()]).all(), f"P = {p}: {path}")
+            with h5py.File(ckpt, "r") as f:  # the cuts: processes, kind, boundaries
+                self.assertEqual(f["distribution"][0], p)
+
     def test_one_message_a_job(self):
         result = grbd(2, "validate", self.scene)
         self.assertEqual(result.returncode, 0, result.stderr)

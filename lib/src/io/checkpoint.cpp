@@ -139,6 +139,15 @@ std::uint64_t header_checksum(const Checkpoint& c, std::uint64_t bodies, std::ui
   return sum.value();
 }
 
+// The checksum of the distribution's state, kept apart from the state's: the state's checksum is
+// the same whatever the number of processes that wrote it, the cuts are theirs.
+std::uint64_t distribution_checksum(const std::vector<double>& distribution) {
+  Checksum sum;
+  sum.add(static_cast<std::uint64_t>(distribution.size()));
+  for (const double x : distribution) sum.add(x);
+  return sum.value();
+}
+
 std::uint64_t body_checksum(std::uint64_t row, const timestep::PackedBody& body) {
   Checksum sum;
   sum.add(std::uint64_t{'b'});
@@ -261,6 +270,13 @@ void write_temporary(const Communicator& comm, const std::filesystem::path& temp
   const std::uint64_t g = s.generators.size();
   h5::write_rows(root, "generators", H5T_STD_U64LE, H5T_NATIVE_UINT64, g, 2, 0,
                  comm.rank() == 0 ? g : 0, generators.data(), x, file);
+  // The distribution's state (the partition of a parallel run), the same on every process.
+  if (const std::uint64_t d = s.distribution.size(); d > 0) {
+    h5::write_rows(root, "distribution", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, d, 0, 0,
+                   comm.rank() == 0 ? d : 0, s.distribution.data(), x, file);
+    h5::write_attribute(root, "distribution_checksum", distribution_checksum(s.distribution),
+                        file);
+  }
   check(H5Fflush(root, H5F_SCOPE_LOCAL), file, "cannot flush the checkpoint");
   if (!handle.close()) h5::fail(file, "cannot close the checkpoint");
 }
@@ -479,6 +495,16 @@ void read_part(const Communicator& comm, const std::filesystem::path& path, Part
   s.generators.resize(g);
   for (std::uint64_t k = 0; k < g; ++k)
     s.generators[k] = {generators[2 * k], generators[2 * k + 1]};
+  if (H5Lexists(root, "distribution", H5P_DEFAULT) > 0) {
+    h5::read_array(root, "distribution", H5T_NATIVE_DOUBLE, -1, 0, s.distribution, file);
+    if (H5Aexists(root, "distribution_checksum") <= 0 ||
+        h5::read_uint(root, "distribution_checksum", file) !=
+            distribution_checksum(s.distribution)) {
+      h5::fail(file,
+               "is damaged: dataset distribution does not match its checksum "
+               "(attribute distribution_checksum)");
+    }
+  }
   // Version 2 carries a checksum of every value in sequence: damage is named as damage.
   if (version == 2 && part.checksum != sequential_checksum(c)) {
     h5::fail(file, "is damaged: the checksum of its values does not match the one written with it");

@@ -245,7 +245,18 @@ RunResult run(const scene::Scene& scene, const RunOptions& options, const Commun
         root && !difference.empty() && options.on_warning) {
       options.on_warning(difference);
     }
-    if (distribution) distribution->redistribute(checkpoint.state);
+    if (distribution) {
+      // The cuts the checkpoint's run stepped on (after its balances), when it had as many
+      // processes: then the restart steps as the run it continues, bit for bit.
+      agree(comm, [&] {
+        try {
+          distribution->restore(checkpoint.state.distribution);
+        } catch (const InvalidArgument& e) {
+          throw IoError(options.restart->string() + ": dataset distribution: " + e.what());
+        }
+      });
+      distribution->redistribute(checkpoint.state);
+    }
     agree(comm, [&] {
       simulation = restored_simulation(scene, checkpoint, *options.restart, distribution.get());
     });
@@ -302,10 +313,13 @@ RunResult run(const scene::Scene& scene, const RunOptions& options, const Commun
     if (saved_at == sim.stepper().steps()) return;
     saved_at = sim.stepper().steps();
     const auto t0 = std::chrono::steady_clock::now();
+    // The state a restart starts in (every body with its owner): the run goes on as it will.
+    agree(comm, [&] { sim.settle(); });
     written([&] {
       output->flush(sim);
-      write_checkpoint(comm, options.checkpoint,
-                       Checkpoint{sim.save(), output->position(), scene.text});
+      Checkpoint checkpoint{sim.save(), output->position(), scene.text};
+      if (distribution) checkpoint.state.distribution = distribution->state();
+      write_checkpoint(comm, options.checkpoint, checkpoint);
     });
     ++result.checkpoints;
     result.output_seconds += seconds_since(t0);

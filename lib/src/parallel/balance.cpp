@@ -27,6 +27,31 @@ void require_weights(std::span<const Vector3> centres, std::span<const double> w
   }
 }
 
+std::vector<double> CartesianGrid::cuts() const {
+  std::vector<double> all;
+  for (int d = 0; d < 3; ++d) all.insert(all.end(), boundaries(d).begin(), boundaries(d).end());
+  return all;
+}
+
+std::unique_ptr<Partition> CartesianGrid::with_cuts(std::span<const double> cuts) const {
+  std::array<std::vector<double>, 3> b;
+  std::size_t at = 0;
+  for (int d = 0; d < 3; ++d) {
+    const auto n = static_cast<std::size_t>(dims()[static_cast<std::size_t>(d)]) + 1;
+    if (at + n > cuts.size()) break;
+    b[static_cast<std::size_t>(d)].assign(cuts.begin() + static_cast<std::ptrdiff_t>(at),
+                                          cuts.begin() + static_cast<std::ptrdiff_t>(at + n));
+    at += n;
+  }
+  if (at != cuts.size() || b[2].empty()) {
+    throw InvalidArgument("CartesianGrid: expected " +
+                          std::to_string(dims()[0] + dims()[1] + dims()[2] + 3) +
+                          " boundaries for a grid of " + std::to_string(size()) +
+                          " subdomains, found " + std::to_string(cuts.size()));
+  }
+  return std::make_unique<CartesianGrid>(domain(), b, periodic());
+}
+
 std::unique_ptr<Partition> CartesianGrid::rebalanced(const Communicator& comm,
                                                      std::span<const Vector3> centres,
                                                      std::span<const double> weights) const {

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <string>
 
+#include "grbd/core/checks.hpp"
 #include "grbd/core/error.hpp"
 #include "grbd/parallel/balance.hpp"
 
@@ -207,6 +208,42 @@ int BisectionTree::owner_of(const Vector3& position) const {
   return nodes_[k].first;
 }
 // [tree owner]
+
+std::vector<double> BisectionTree::cuts() const {
+  std::vector<double> all;
+  for (const Node& node : nodes_) {
+    all.push_back(node.axis);
+    all.push_back(node.cut);
+  }
+  return all;
+}
+
+std::unique_ptr<Partition> BisectionTree::with_cuts(std::span<const double> cuts) const {
+  // The shape of the tree is the even tree's for as many processes; the cuts are the given ones.
+  auto tree = std::make_unique<BisectionTree>(domain(), size(), periodic());
+  if (cuts.size() != 2 * tree->nodes_.size()) {
+    throw InvalidArgument("BisectionTree: expected an axis and a cut for each of the " +
+                          std::to_string(tree->nodes_.size()) + " nodes of a tree of " +
+                          std::to_string(size()) + " leaves, found " +
+                          std::to_string(cuts.size()) + " numbers");
+  }
+  for (std::size_t k = 0; k < tree->nodes_.size(); ++k) {
+    Node& node = tree->nodes_[k];
+    const double axis = cuts[2 * k], cut = cuts[2 * k + 1];
+    const bool leaf = node.count == 1;
+    if (leaf ? axis != -1.0 : !(axis == 0.0 || axis == 1.0 || axis == 2.0) || !std::isfinite(cut)) {
+      throw InvalidArgument("BisectionTree: node " + std::to_string(k) + " expected " +
+                            (leaf ? std::string("a leaf (axis -1)")
+                                  : std::string("an axis 0, 1 or 2 and a finite cut")) +
+                            ", found axis " + format_number(axis) + " and cut " +
+                            format_number(cut));
+    }
+    node.axis = static_cast<int>(axis);
+    node.cut = cut;
+  }
+  tree->make_leaves();
+  return tree;
+}
 
 std::unique_ptr<Partition> BisectionTree::rebalanced(const Communicator& comm,
                                                      std::span<const Vector3> centres,

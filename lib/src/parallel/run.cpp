@@ -157,6 +157,28 @@ void SceneDecomposition::redistribute(scene::SimulationState& state) const {
   send_to_owners(comm_, *this, state);
 }
 
+namespace {
+double partition_kind(const Partition& partition) {
+  return dynamic_cast<const BisectionTree*>(&partition) != nullptr ? 1.0 : 0.0;
+}
+}  // namespace
+
+std::vector<double> SceneDecomposition::state() const {
+  const Partition& partition = engine_ != nullptr ? engine_->partition() : *partition_;
+  std::vector<double> state{static_cast<double>(comm_.size()), partition_kind(partition)};
+  const std::vector<double> cuts = partition.cuts();
+  state.insert(state.end(), cuts.begin(), cuts.end());
+  return state;
+}
+
+void SceneDecomposition::restore(std::span<const double> state) {
+  if (state.size() < 2 || state[0] != static_cast<double>(comm_.size()) ||
+      state[1] != partition_kind(*partition_)) {
+    return;
+  }
+  partition_ = partition_->with_cuts(state.subspan(2));
+}
+
 bool needs_decomposition(const scene::Scene& scene, const Communicator& comm) {
   return comm.size() > 1 || scene.domain.any_periodic();
 }

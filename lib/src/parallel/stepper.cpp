@@ -76,36 +76,43 @@ ParallelStepper::ParallelStepper(const Communicator& comm, const Partition& part
 
 ParallelStepper::~ParallelStepper() = default;
 
+void ParallelStepper::rebuild() {
+  exchange_->migrate(system_, stepper_->warm_starts());
+  exchange_->borders(system_);
+  reference_.resize(system_.owned_count());
+  for (std::size_t i = 0; i < reference_.size(); ++i) {
+    reference_[i] = system_.states()[i].q.head<3>();
+  }
+  ++rebuilds_;
+  changed_ = false;
+}
+
+void ParallelStepper::settle() { rebuild(); }
+
 // [parallel step]
 timestep::StepReport ParallelStepper::step() {
   if (rebuild_due()) {
-    rebalance_if_due();
-    exchange_->migrate(system_, stepper_->warm_starts());
-    exchange_->borders(system_);
-    reference_.resize(system_.owned_count());
-    for (std::size_t i = 0; i < reference_.size(); ++i) {
-      reference_[i] = system_.states()[i].q.head<3>();
-    }
-    ++rebuilds_;
-    changed_ = false;
+    rebuild();
   } else {
     exchange_->forward(system_);
   }
-  return stepper_->step();
+  const timestep::StepReport report = stepper_->step();
+  rebalance_if_due();
+  return report;
 }
 // [parallel step]
 
 // [rebalance]
-// At a rebuild, every rebalance_every steps: when the most loaded process carries more than
-// imbalance times the mean weight (1 per body, 1 per contact it took part in at the last step),
+// After every rebalance_every-th step (counted from the start of the run, so that a restart looks
+// at the same steps), with the weights of that step's contacts: when the most loaded process
+// carries more than imbalance times the mean weight (1 per body, 1 per contact it took part in),
 // the partition is rebalanced (Partition::rebalanced: the balanced grid, or the balanced bisection
-// tree, of the bodies), and every body moves to its new owner (an
-// exchange among all processes, which a rebalance may send a body to), with its warm starts.
+// tree, of the bodies), and every body moves to its new owner (an exchange among all processes,
+// which a rebalance may send a body to), with its warm starts; the next step rebuilds the ghosts.
+// A checkpoint written after this step keeps the new cuts.
 void ParallelStepper::rebalance_if_due() {
   const std::uint64_t step = stepper_->steps();
-  if (rebalance_every_ == 0 || step < balanced_at_ + static_cast<std::uint64_t>(rebalance_every_))
-    return;
-  balanced_at_ = step;
+  if (rebalance_every_ == 0 || step % static_cast<std::uint64_t>(rebalance_every_) != 0) return;
   const std::size_t n = system_.owned_count();
   std::vector<double> weights(n, 1.0);
   for (const timestep::DetectedContact& c : stepper_->contacts()) {
@@ -114,13 +121,22 @@ void ParallelStepper::rebalance_if_due() {
         weights[static_cast<std::size_t>(row)] += 1.0;
     }
   }
-  double mine = 0.0;
-  for (const double w : weights) mine += w;
-  std::vector<double> largest{mine}, total{mine};
-  comm_.max(largest);
-  comm_.sum(total);
-  const double mean = total[0] / comm_.size();
-  if (!(largest[0] > imbalance_ * mean)) return;
+  // Each process's load as the partition assigns the bodies, not as they happen to lie now (a
+  // body that crossed a cut since the last rebuild still lives with its old owner): the same
+  // verdict whenever the ghosts were last rebuilt, so that a restart, which rebuilds at once,
+  // balances as the run it continues. The weights are whole numbers: their sums are exact.
+  std::vector<double> loads(static_cast<std::size_t>(comm_.size()), 0.0);
+  for (std::size_t i = 0; i < n; ++i) {
+    loads[static_cast<std::size_t>(partition_->owner_of(system_.states()[i].q.head<3>()))] +=
+        weights[i];
+  }
+  comm_.sum(loads);
+  double total = 0.0, largest = 0.0;
+  for (const double load : loads) {
+    total += load;
+    largest = std::max(largest, load);
+  }
+  if (!(largest > imbalance_ * total / comm_.size())) return;
   std::vector<Vector3> centres(n);
   for (std::size_t i = 0; i < n; ++i) centres[i] = system_.states()[i].q.head<3>();
   exchange_.reset();  // it refers to the partition replaced here
@@ -130,6 +146,7 @@ void ParallelStepper::rebalance_if_due() {
   BodyExchange all(comm_, *partition_, margin_, everywhere);
   all.migrate(system_, stepper_->warm_starts());
   exchange_.emplace(comm_, *partition_, margin_, max_radius_);
+  changed_ = true;  // the ghosts went with the migration: rebuild them before the next step
   ++rebalances_;
 }
 // [rebalance]

@@ -46,6 +46,8 @@ class BisectionTree final : public Partition {
     return std::make_unique<BisectionTree>(*this);
   }
   /// The balanced() tree of the bodies with as many leaves.
+  std::vector<double> cuts() const override;
+  std::unique_ptr<Partition> with_cuts(std::span<const double> cuts) const override;
   std::unique_ptr<Partition> rebalanced(const Communicator& comm, std::span<const Vector3> centres,
                                         std::span<const double> weights) const override;
 

@@ -44,6 +44,8 @@ class CartesianGrid final : public Partition {
     return std::make_unique<CartesianGrid>(*this);
   }
   /// The balanced_grid() of the bodies with the same dims.
+  std::vector<double> cuts() const override;
+  std::unique_ptr<Partition> with_cuts(std::span<const double> cuts) const override;
   std::unique_ptr<Partition> rebalanced(const Communicator& comm, std::span<const Vector3> centres,
                                         std::span<const double> weights) const override;
 

@@ -38,6 +38,14 @@ class Partition {
                                                 std::span<const Vector3> centres,
                                                 std::span<const double> weights) const = 0;
 
+  /// The cuts as numbers (CartesianGrid: its boundaries along x, y and z; BisectionTree: each
+  /// node's axis and cut): what a checkpoint keeps, so that a restart on as many processes goes on
+  /// over the same subdomains after a balance moved them.
+  virtual std::vector<double> cuts() const = 0;
+  /// The partition of the same kind, size and domain over `cuts` (as cuts() gives them); throws
+  /// InvalidArgument when they do not fit it.
+  virtual std::unique_ptr<Partition> with_cuts(std::span<const double> cuts) const = 0;
+
   /// Number of subdomains (= processes).
   virtual int size() const = 0;
   /// The box of a rank's subdomain; throws InvalidArgument for a rank outside [0, size()).

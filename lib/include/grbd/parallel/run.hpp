@@ -58,6 +58,13 @@ class SceneDecomposition final : public scene::Distribution {
   /// owns its centre, every warm start to the one that solves its contact (solves_contact()), in
   /// three exchanges among all processes, each of O(N/P) rows (collective).
   void redistribute(scene::SimulationState& state) const override;
+  /// The number of processes, the partition's kind (0: grid, 1: bisection tree) and its cuts
+  /// (Partition::cuts: the engine's, which a balance may have moved).
+  std::vector<double> state() const override;
+  /// Takes the cuts of a state() written by as many processes over a partition of the same kind;
+  /// any other state leaves the scene's partition (a restart on another number of processes
+  /// balances anew).
+  void restore(std::span<const double> state) override;
   /// The partition the run starts from.
   const Partition& partition() const { return *partition_; }
   /// The parallel step's settings (largest bounding radius of the scene's groups).

@@ -30,11 +30,13 @@ struct ParallelSettings {
   /// that disagree in between; the solver stops only after a sweep that was averaged, and the last
   /// sweep it may do (max_iterations) is always averaged.
   int average_every = 1;
-  /// Look at the balance of the processes' work every this many steps (0: never), at the first
-  /// rebuild of the ghosts after it; when the most loaded process has more than `imbalance` times
-  /// the mean weight (a body weighs 1 plus its contacts of the last step), the partition is
-  /// replaced by its Partition::rebalanced() for the bodies (a balanced_grid(), or a
-  /// BisectionTree::balanced() tree) and every body moves to its new owner.
+  /// Look at the balance of the processes' work after every step whose number is a multiple of
+  /// this (0: never); when the most loaded process has more than `imbalance` times the mean
+  /// weight (a body weighs 1 plus its contacts of that step), the partition is replaced by its
+  /// Partition::rebalanced() for the bodies (a balanced_grid(), or a BisectionTree::balanced()
+  /// tree), every body moves to its new owner and the next step rebuilds the ghosts. The steps
+  /// are counted from the start of the run, so that a restart from a checkpoint that kept the cuts
+  /// (scene::Distribution::state) balances at the same steps.
   int rebalance_every = 0;
   double imbalance = 1.1;  ///< the largest load over the mean that needs no rebalancing, ≥ 1
 };
@@ -78,6 +80,10 @@ class ParallelStepper final : public scene::StepEngine {
   timestep::MoreauStepper& stepper() override { return *stepper_; }  ///< the same
   /// Bodies were added or removed since the last step: the next step rebuilds the ghosts.
   void bodies_changed() override { changed_ = true; }
+  /// Before a checkpoint: every body moves to the process that owns it and the ghosts are rebuilt
+  /// (migrate, borders), as a restart from the checkpoint starts — so that the run goes on as the
+  /// restart will, bit for bit, on as many processes.
+  void settle() override;
   /// How often the ghosts were rebuilt.
   std::uint64_t rebuilds() const { return rebuilds_; }
   /// Wall time spent so far averaging the split bodies' velocities (with its exchanges) [s].
@@ -91,6 +97,7 @@ class ParallelStepper final : public scene::StepEngine {
 
  private:
   bool rebuild_due() const;
+  void rebuild();  // migrate, borders, and the reference positions of the skin's rule
   void rebalance_if_due();
   void select_contacts(const timestep::BodySystem& system,
                        std::vector<timestep::DetectedContact>& contacts,
@@ -121,7 +128,6 @@ class ParallelStepper final : public scene::StepEngine {
   std::uint64_t rebuilds_ = 0;
   std::uint64_t rebalances_ = 0;
   double averaging_seconds_ = 0.0;
-  std::uint64_t balanced_at_ = 0;  // the step of the last look at the balance
   std::size_t split_owned_ = 0;
   bool any_split_ = false;
   bool changed_ = false;  // bodies added or removed here since the last rebuild

@@ -36,6 +36,9 @@ struct SimulationState {
   std::vector<timestep::ContactKey> warm_keys;  ///< the stepper's warm starts
   std::vector<Vector3> warm_lambda;             ///< their percussions
   std::vector<GeneratorState> generators;       ///< one per body group
+  /// The state of the run's Distribution (chapter 8: the processes and the partition's cuts,
+  /// which a balance moves), the same on every process; empty for a run without one.
+  std::vector<double> distribution;
 };
 
 /// A saved state (a checkpoint's) that does not fit the scene it is restored into, or holds a
@@ -62,6 +65,10 @@ class StepEngine {
   virtual timestep::MoreauStepper& stepper() = 0;
   /// Told when bodies were added or removed between steps (inflow, outlet).
   virtual void bodies_changed() {}
+  /// Before a checkpoint (collective): brings the engine into the state that a restart from the
+  /// checkpoint starts in, so that the run goes on as the restart will (chapter 8: every body
+  /// with the process that owns it, the ghosts rebuilt). The serial engine has nothing to do.
+  virtual void settle() {}
 };
 
 /// How the processes of a parallel run share a scene (chapter 8), handed to a Simulation by the
@@ -85,6 +92,13 @@ class Distribution {
   virtual void redistribute(SimulationState& state) const = 0;
   /// How often the engine re-cut the domain to even the load so far.
   virtual std::uint64_t rebalances() const = 0;
+  /// What a checkpoint keeps of the distribution (SimulationState::distribution), the same on
+  /// every process.
+  virtual std::vector<double> state() const = 0;
+  /// Continues from a checkpoint's state() before the simulation is built: the same cuts when it
+  /// was written by as many processes (a restart then steps as the run it continues), else the
+  /// scene's own partition. Throws InvalidArgument for a state that does not fit the scene.
+  virtual void restore(std::span<const double> state) = 0;
 };
 
 /// A runnable scene. Construction generates the initial bodies (list, lattice and packing
@@ -121,6 +135,8 @@ class Simulation {
   /// Everything the next step depends on (in a parallel run: this process's bodies and warm
   /// starts, and the counts of the whole run).
   SimulationState save() const;
+  /// Before a checkpoint: StepEngine::settle() (collective in a parallel run).
+  void settle() { engine_->settle(); }
 
   /// \name Parts
   ///@{
