@@ -553,10 +553,10 @@ class Incline(Runs):
                 # At 24° the layer flows (glass beads stop below about 21°): downstream, and
                 # never backwards.
                 self.assertGreater(mean, 0.02, f"P = {p}")
-                # The speed over the second half of the run: one record's speed wanders by ±50 %
-                # from run to run once the flow has begun (0.033-0.10 m/s at 0.3 s on 2 and 3
-                # processes with balances every 25 or 50 steps), its mean over the second half
-                # by ±25 %.
+                # The speed over the second half of the run. The onset of a flow of 150 beads is
+                # chaotic: a change in the order the contacts are solved in (another partition,
+                # a balance, a Morton reordering) moves one record's speed at 0.3 s between 0.033
+                # and 0.10 m/s, the mean over the second half between 0.054 and 0.091 m/s.
                 speeds.append(float(np.mean([
                     f[f"records/{k:06d}/I_v_S"][()][
                         ~np.isin(f[f"records/{k:06d}/id"][()], base), 0].mean()
@@ -564,11 +564,11 @@ class Incline(Runs):
                 heights.append(float(x[~on_base, 2].mean()))
         # Two or three processes that balance their loads do not step bit for bit as one
         # (contacts solved in another order, split beads averaged), and the onset of a flow
-        # amplifies the difference: the layers settle to the same height to 2 %, and flow at the
-        # same mean speed to 30 %.
-        for height, speed in zip(heights[1:], speeds[1:]):
+        # amplifies the difference: the layers settle to the same height to 2 %, and flow at mean
+        # speeds within a factor of two of one another (a layer that locked or ran away would not).
+        for height in heights[1:]:
             self.assertLess(abs(height - heights[0]), 0.02 * heights[0], heights)
-            self.assertLess(abs(speed - speeds[0]), 0.3 * speeds[0], speeds)
+        self.assertLess(max(speeds), 2.0 * min(speeds), speeds)
 
 
 class Periodic(Runs):

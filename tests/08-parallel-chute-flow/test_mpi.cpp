@@ -476,6 +476,44 @@ TEST(ParallelStepper, FreeFlightAcrossSubdomainsIsTheSerialRunBitForBit) {
   EXPECT_LT(parallel.rebuilds(), 150u);  // … but not at every step
 }
 
+// The scene's Morton reordering (StepSettings::reorder_interval) on many processes: every 10 steps
+// each process reorders its own bodies along the Morton curve, as the serial engine does. The
+// bodies are at rest (no gravity, no drift), so that after the step that followed a reordering
+// each process's bodies must be in the order BodySystem::reorder_morton gives them; free flight
+// stays the serial run.
+TEST(ParallelStepper, MortonReorderingIsDoneOnEveryProcessAndKeepsTheSerialRun) {
+  const int p = world->size();
+  const Box domain(Vector3(0, 0, 0), Vector3(1, 1, 1));
+  const CartesianGrid grid(domain, grid_dims(p, domain.sizes()));
+  timestep::BodySystem serial;
+  timestep::BodySystem mine;
+  // Ids along z first: the Morton order is another one.
+  add_flight(serial, mine, grid, {6, 6, 6}, Vector3(0.1, 0.1, 0.1), Vector3(0.16, 0.16, 0.16),
+             Vector3::Zero(), 0.0, 3);
+  timestep::StepSettings settings = flight(0.02);
+  settings.I_g = Vector3::Zero();
+  settings.reorder_interval = 10;
+  const timestep::StaticGeometry statics;
+  const timestep::MaterialTable materials = glass();
+  ParallelStepper parallel(*world, grid, mine, statics, materials, settings, {0.005});
+  const auto ids = [](const timestep::BodySystem& system) {
+    return std::vector<std::uint64_t>(system.ids().begin(),
+                                      system.ids().begin() +
+                                          static_cast<std::ptrdiff_t>(system.owned_count()));
+  };
+  std::vector<std::uint64_t> before;
+  for (int step = 0; step < 11; ++step) {  // collective: no ASSERT inside, no early exit
+    if (step == 10) before = ids(mine);
+    parallel.step();
+  }
+  // Step 11 began with the reordering due after 10 steps.
+  timestep::BodySystem expected;
+  for (std::size_t i = 0; i < mine.owned_count(); ++i) expected.add(mine.record(i));
+  expected.reorder_morton(2.0 * 0.005);
+  EXPECT_EQ(ids(mine), ids(expected));
+  EXPECT_NE(ids(mine), before) << "nothing was reordered: nothing was tested";
+}
+
 // Bodies crowded into one corner of the domain, all owned by one process at the start: every 5
 // steps the stepper looks at the balance and moves the grid's boundaries to the bodies' weighted
 // quantiles, and the bodies to their new owners — far beyond the neighbours. Free flight stays the

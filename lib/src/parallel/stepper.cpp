@@ -25,6 +25,7 @@ ParallelStepper::ParallelStepper(const Communicator& comm, const Partition& part
       skin_(settings.skin),
       average_every_(parallel.average_every),
       max_iterations_(settings.solver.max_iterations),
+      reorder_interval_(settings.reorder_interval),
       rebalance_every_(parallel.rebalance_every),
       imbalance_(parallel.imbalance),
       margin_(settings.contact_tolerance * settings.tolerance_radius + settings.skin),
@@ -78,6 +79,9 @@ ParallelStepper::~ParallelStepper() = default;
 
 void ParallelStepper::rebuild() {
   exchange_->migrate(system_, stepper_->warm_starts());
+  // Between migration and borders the system holds only its own bodies: the place where the
+  // serial engine's Morton reordering (StepSettings::reorder_interval) fits, when it is due.
+  stepper_->reorder_if_due();
   exchange_->borders(system_);
   reference_.resize(system_.owned_count());
   for (std::size_t i = 0; i < reference_.size(); ++i) {
@@ -91,7 +95,8 @@ void ParallelStepper::settle() { rebuild(); }
 
 // [parallel step]
 timestep::StepReport ParallelStepper::step() {
-  if (rebuild_due()) {
+  // A reordering moves rows under the ghosts' bookkeeping: it comes with a rebuild.
+  if (reorder_due() || rebuild_due()) {
     rebuild();
   } else {
     exchange_->forward(system_);
@@ -150,6 +155,13 @@ void ParallelStepper::rebalance_if_due() {
   ++rebalances_;
 }
 // [rebalance]
+
+// The serial engine's Morton reordering is due before this step (the same on every process).
+bool ParallelStepper::reorder_due() const {
+  const auto interval = static_cast<std::uint64_t>(std::max(0, reorder_interval_));
+  const std::uint64_t step = stepper_->steps();
+  return interval > 0 && step > 0 && step % interval == 0;
+}
 
 // Some body of some process has moved more than half the skin since the last rebuild (the rule of
 // the candidate list).

@@ -57,6 +57,8 @@ struct ParallelSettings {
 ///   after each averaged sweep only, and the report sums contacts and
 ///   energies over the processes (in rank order) and takes the largest residual, penetration and
 ///   iteration count.
+/// Every reorder_interval steps (StepSettings) the ghosts are rebuilt and, between migration and
+/// borders, each process reorders its own bodies along the Morton curve, as the serial engine does.
 /// With one process and no periodic axis there are no ghosts, and the step is the serial step.
 class ParallelStepper final : public scene::StepEngine {
  public:
@@ -97,6 +99,7 @@ class ParallelStepper final : public scene::StepEngine {
 
  private:
   bool rebuild_due() const;
+  bool reorder_due() const;
   void rebuild();  // migrate, borders, and the reference positions of the skin's rule
   void rebalance_if_due();
   void select_contacts(const timestep::BodySystem& system,
@@ -111,6 +114,7 @@ class ParallelStepper final : public scene::StepEngine {
   double skin_;
   int average_every_;
   int max_iterations_;
+  int reorder_interval_;  // StepSettings::reorder_interval: Morton reordering at rebuilds
   int sweep_ = 0;  // sweeps of the current solve (velocities_between_sweeps' k)
   int rebalance_every_;
   double imbalance_;
