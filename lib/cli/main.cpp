@@ -532,7 +532,7 @@ int fclib_command(const std::vector<std::string>& inputs, double tol, int max_it
     options.record_history = csv.has_value();
     bool header = false;  // printed with the first row: not before a file that is refused
     grbd::contact::fclib_bench(files, options, [&](const grbd::contact::FclibBenchRow& row) {
-      if (!std::exchange(header, true)) std::cout << grbd::contact::fclib_table_header();
+      if (!std::exchange(header, true)) std::cout << grbd::contact::fclib_table_header(max_iterations);
       std::cout << grbd::contact::fclib_table_line(row) << std::flush;
       for (std::size_t k = 0; k < row.history.size(); ++k) {
         history << row.problem << ',' << row.solver << ',' << k + 1 << ',' << row.history[k]
@@ -750,7 +750,10 @@ int grbd_main(int argc, char** argv) {
           "T > 0"));
   fclib
       ->add_option("--max-iterations", fclib_max_iterations,
-                   "At most this many iterations per solver and problem, default 20000")
+                   "At most this many iterations per solver and problem, default 20000; "
+                   "Newton's methods at most " +
+                       std::to_string(grbd::contact::kFclibNewtonIterations) +
+                       " (each iteration a linear solve). The table's header gives the caps.")
       ->check(CLI::Range(1, 1 << 30));
   fclib->add_option("--csv", fclib_csv, "Write every iteration's |F|/|q| to this CSV file");
   fclib->footer(kFclibExitCodes);

@@ -544,6 +544,20 @@ class Fclib(Scratch):
         last = float(lines[-1].split(",")[3])
         self.assertLessEqual(last, 1e-6)
 
+    def test_fclib_says_the_caps_it_ran_with(self):
+        problem = os.path.join(FCLIB_DATA, "Spheres-i099-356-679.hdf5")
+        for args, caps in (([], "caps: 20000 iterations, Newton 200"),
+                           (["--max-iterations", "7"], "caps: 7 iterations, Newton 7")):
+            result = run("fclib", problem, *args)
+            self.assertEqual(result.returncode, 0, result.stderr)
+            self.assertTrue(result.stdout.splitlines()[0].endswith(caps), result.stdout)
+            rows = [line.split() for line in result.stdout.splitlines()[1:]]
+            cap = int(caps.split()[-1])
+            for r in rows:
+                if r[1].startswith("Newton"):  # problem, solver, contacts, iterations, …
+                    self.assertLessEqual(int(r[3]), cap, r)
+        self.assertIn("Newton's methods at most 200", run("fclib", "--help").stdout)
+
     def test_fclib_refuses_bad_problems_and_options(self):
         text = self.path("not.hdf5")
         with open(text, "w") as f:

@@ -141,6 +141,7 @@ TEST(DepthProfile, ALayerAtRestOnAnInclineCarriesItsWeightThroughItsContacts) {
       "domain = { min = [0.0, 0.0, -0.01], max = [0.0092, 0.0092, 1.0] }\n"
       "periodic = [\"x\", \"y\"]\n"
       "[solver]\nmethod = \"sor\"\ntolerance = 1e-4\nmax_iterations = 200\n"
+      "reorder_interval = 0\n"
       "[[material]]\nname = \"glass\"\n"
       "[[contact]]\nmaterials = [\"glass\", \"glass\"]\nmu = 0.5\n"
       "[[bodies]]\nname = \"base\"\nradius = 0.001\ndensity = 2500.0\nmaterial = \"glass\"\n"
@@ -152,7 +153,10 @@ TEST(DepthProfile, ALayerAtRestOnAnInclineCarriesItsWeightThroughItsContacts) {
       "kind = \"lattice\"\nregion = { min = [0.0, 0.0, 0.0023], max = [0.0092, 0.0092, 0.1] }\n"
       "spacing = 0.0023\ncount = 120\njitter = 0.5\n";
   // Fallen and nearly at rest after 0.6 s; then a few steps solved to 10⁻⁹, which stop the last
-  // rattlers, so that the percussions balance gravity to the solver's accuracy.
+  // rattlers, so that the percussions balance gravity to the solver's accuracy. When a loose layer
+  // comes to rest depends on the order its contacts are solved in: this realization (no Morton
+  // reordering) is at rest after 0.6 s, the one with a reordering every 100 steps still creeps
+  // down by 0.1 mm/s and a bead rolls off in the exact steps.
   const scene::Scene scene = scene::parse_scene(text, "at_rest.toml");
   const SceneDecomposition one(self_communicator(), scene);
   scene::Simulation fall(scene, nullptr, one);

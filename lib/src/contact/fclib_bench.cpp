@@ -40,7 +40,6 @@ std::vector<fs::path> fclib_files(const std::string& argument) {
 
 namespace {
 
-constexpr int kNewtonIterations = 200;  // Newton's cap in the bench (see fclib_bench())
 
 struct Run {
   std::string name;
@@ -75,11 +74,11 @@ void fclib_bench(const std::vector<fs::path>& files, const FclibBenchOptions& op
   runs[5].name = "Newton-GMRES";
   runs[5].method = Method::newton;
   runs[5].options.newton.linear_solver = LinearSolver::gmres;
-  // A Newton iteration is a linear solve: kNewtonIterations of them are as much work as tens of
+  // A Newton iteration is a linear solve: kFclibNewtonIterations of them are as much work as tens of
   // thousands of sweeps (GMRES's products with W cost a JOR iteration each).
   for (Run& run : runs) {
     if (run.method == Method::newton) {
-      run.options.max_iterations = std::min(options.max_iterations, kNewtonIterations);
+      run.options.max_iterations = std::min(options.max_iterations, kFclibNewtonIterations);
     }
   }
 
@@ -114,11 +113,16 @@ void fclib_bench(const std::vector<fs::path>& files, const FclibBenchOptions& op
   }
 }
 
-std::string fclib_table_header() {
+std::string fclib_table_header(int max_iterations) {
   char line[256];
-  std::snprintf(line, sizeof line, "%-44s %-12s %4s %9s %10s %10s %10s %s\n", "problem", "solver",
+  std::snprintf(line, sizeof line, "%-44s %-12s %4s %9s %10s %10s %10s %s", "problem", "solver",
                 "n", "iter", "|F|/|q|", "|F|/max", "time [ms]", "");
-  return line;
+  std::string header = line;
+  if (max_iterations > 0) {
+    header += "caps: " + std::to_string(max_iterations) + " iterations, Newton " +
+              std::to_string(std::min(max_iterations, kFclibNewtonIterations));
+  }
+  return header + '\n';
 }
 
 std::string fclib_table_line(const FclibBenchRow& row) {

@@ -12,6 +12,10 @@
 
 namespace grbd::contact {
 
+/// The most iterations the bench gives Newton's methods (each iteration is a linear solve):
+/// min(FclibBenchOptions::max_iterations, this).
+inline constexpr int kFclibNewtonIterations = 200;
+
 /// How the bench solves.
 struct FclibBenchOptions {
   double tol = 1e-8;            ///< stop once ‖F‖ ≤ tol ‖q‖ (the natural-map residual)
@@ -40,14 +44,15 @@ struct FclibBenchRow {
 std::vector<std::filesystem::path> fclib_files(const std::string& argument);
 
 /// Solves every problem of `files` with SOR (Alart–Curnier and De Saxcé prox), JOR (α = 0.5,
-/// one global r), APGD, Newton with the sparse LU and Newton with GMRES (at most 200 Newton
-/// iterations, or max_iterations if fewer), and SOR warm from the file's guess where it holds one;
+/// one global r), APGD, Newton with the sparse LU and Newton with GMRES (at most
+/// kFclibNewtonIterations Newton iterations, or max_iterations if fewer), and SOR warm from the file's guess where it holds one;
 /// calls `row` after each solve. Throws what the FCLIB reader throws for a file it cannot read.
 void fclib_bench(const std::vector<std::filesystem::path>& files, const FclibBenchOptions& options,
                  const std::function<void(const FclibBenchRow&)>& row);
 
-/// The header of the bench's table: fixed-width columns, ending in a newline.
-std::string fclib_table_header();
+/// The header of the bench's table: fixed-width columns, ending in a newline; with
+/// `max_iterations` > 0 it ends in the caps of the run ("caps: N iterations, Newton min(N, 200)").
+std::string fclib_table_header(int max_iterations = 0);
 /// A row of the bench's table, in the columns of fclib_table_header().
 std::string fclib_table_line(const FclibBenchRow& row);
 
