@@ -51,7 +51,7 @@ BodyExchange::BodyExchange(const Communicator& comm, const Partition& partition,
                           format_number(margin));
   }
   require_positive_finite("BodyExchange", "max_radius", max_radius);
-  neighbours_ = partition.neighbours(comm.rank(), 2.0 * max_radius + margin);
+  neighbours_ = partition.neighbours(comm.rank(), contact_reach(max_radius, margin));
   const std::size_t m = neighbours_.size();
   sent_.resize(m);
   ghost_start_.assign(m, 0);
@@ -108,7 +108,7 @@ std::size_t BodyExchange::migrate(timestep::BodySystem& system, timestep::WarmSt
   const auto keys = warm.keys();
   const auto lambda = warm.lambda();
   for (std::size_t k = 0; k < keys.size(); ++k) {
-    const timestep::GlobalId decider = (keys[k].a & timestep::kStaticTag) ? keys[k].b : keys[k].a;
+    const timestep::GlobalId decider = solving_side(keys[k]);
     const auto it = std::lower_bound(leaving_.begin(), leaving_.end(),
                                      std::pair<timestep::GlobalId, std::size_t>{decider, 0});
     if (it != leaving_.end() && it->first == decider) {

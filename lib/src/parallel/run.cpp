@@ -46,13 +46,10 @@ void send_to_owners(const Communicator& comm, const SceneDecomposition& decompos
     collective::put(bodies[static_cast<std::size_t>(owner)], packed);
     collective::put(owners[to(body.id)], Owner{body.id, owner});
   }
-  const auto solver_side = [](const timestep::ContactKey& key) {
-    return (key.a & timestep::kStaticTag) != 0 ? key.b : key.a;
-  };
   for (std::size_t k = 0; k < state.warm_keys.size(); ++k) {
     const Vector3& l = state.warm_lambda[k];
     const timestep::ContactKey& key = state.warm_keys[k];
-    collective::put(warm[to(solver_side(key))], Warm{key, {l[0], l[1], l[2]}});
+    collective::put(warm[to(solving_side(key))], Warm{key, {l[0], l[1], l[2]}});
   }
   collective::exchange_with_all(comm, bodies, received);
   state.bodies.clear();
@@ -70,7 +67,7 @@ void send_to_owners(const Communicator& comm, const SceneDecomposition& decompos
   std::vector<Warm> rows = collective::rows_of<Warm>(received);
   for (std::vector<std::byte>& out : warm) out.clear();
   for (const Warm& w : rows) {
-    const std::uint64_t id = solver_side(w.key);
+    const std::uint64_t id = solving_side(w.key);
     const auto it = std::lower_bound(directory.begin(), directory.end(), id,
                                      [](const Owner& o, std::uint64_t x) { return o.id < x; });
     // A warm start of a body the checkpoint does not hold is of no use to anyone.
@@ -127,9 +124,9 @@ SceneDecomposition::SceneDecomposition(const Communicator& comm, const scene::Sc
                 scene.parallel.imbalance} {
   // Along a periodic axis the images one period away must hold every contact (a body within reach
   // of another through two periods would need more), and no body may reach its own image.
-  const timestep::StepSettings& s = scene.settings;
-  const double reach =
-      2.0 * parallel_.max_radius + s.contact_tolerance * s.tolerance_radius + skin_of(s);
+  timestep::StepSettings s = scene.settings;
+  s.skin = skin_of(s);
+  const double reach = contact_reach(parallel_.max_radius, ghost_margin(s));
   const char* axes = "xyz";
   for (int d = 0; d < 3; ++d) {
     const double period = scene.domain.box.max[d] - scene.domain.box.min[d];

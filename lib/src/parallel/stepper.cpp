@@ -28,7 +28,7 @@ ParallelStepper::ParallelStepper(const Communicator& comm, const Partition& part
       reorder_interval_(settings.reorder_interval),
       rebalance_every_(parallel.rebalance_every),
       imbalance_(parallel.imbalance),
-      margin_(settings.contact_tolerance * settings.tolerance_radius + settings.skin),
+      margin_(ghost_margin(settings)),
       max_radius_(parallel.max_radius),
       partition_(partition.clone()) {
   exchange_.emplace(comm, *partition_, margin_, max_radius_);

@@ -11,6 +11,7 @@
 #include "grbd/parallel/partition.hpp"
 #include "grbd/timestep/body_system.hpp"
 #include "grbd/timestep/contacts.hpp"
+#include "grbd/timestep/stepper.hpp"
 
 namespace grbd::parallel {
 
@@ -81,6 +82,26 @@ class CartesianGrid final : public Partition {
 /// r + m. Exercise 8.2.
 bool overlaps(const Vector3& centre, double reach, const Box& box);
 // [overlaps]
+
+/// The side whose owner solves a contact, by its key: side a, or side b when side a is a static
+/// object (kStaticTag). The rule of solves_contact(), for where only the key is at hand: the warm
+/// starts that travel with a migrating body, and those a restart sends to their solver.
+inline timestep::GlobalId solving_side(const timestep::ContactKey& key) {
+  return (key.a & timestep::kStaticTag) != 0 ? key.b : key.a;
+}
+
+/// The margin of the ghosts [m]: a contact is detected within contact_tolerance ×
+/// tolerance_radius of a gap, and the candidate pairs stay valid while no body has moved more than
+/// half the skin: every body a process's bodies can touch before the next rebuild lies within its
+/// bounding radius, the largest one and this margin (BodyExchange, ParallelStepper).
+inline double ghost_margin(const timestep::StepSettings& settings) {
+  return settings.contact_tolerance * settings.tolerance_radius + settings.skin;
+}
+
+/// The reach of a contact between two bodies of bounding radius at most `max_radius` [m]: two
+/// such radii and the ghosts' margin — how far apart two subdomains may be and still exchange
+/// ghosts, and how long a periodic axis must at least be.
+inline double contact_reach(double max_radius, double margin) { return 2.0 * max_radius + margin; }
 
 // [solves contact]
 /// True when this process solves the contact: it owns the contact's side a (side b when side a is
