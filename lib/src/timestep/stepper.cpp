@@ -352,9 +352,13 @@ void MoreauStepper::assemble(StepReport& report) {
 void MoreauStepper::solve(StepReport& report) {
   const std::size_t m = contacts_.size();
   report.contacts = m;
-  if (m == 0) {
+  // Without contacts there is nothing to solve, unless the processes of a parallel run decide
+  // together (a global verdict, chapter 8): then this process's solver takes part in the others'
+  // iterations with its empty problem, in the same loop — offering its velocities to the hook
+  // (a split body's copies elsewhere may change them) and the verdict "converged" once
+  // min_iterations are done, until every process agrees to stop.
+  if (m == 0 && !hooks_.solver.global_status) {
     solution_.u.assign(problem_.u_free.begin(), problem_.u_free.end());
-    if (hooks_.solver.global_status) take_part_without_contacts(report);
     return;
   }
   const contact::SolverResult result = solver_.solve_prepared(problem_, solution_);
@@ -380,29 +384,6 @@ void MoreauStepper::solve(StepReport& report) {
   }
 }
 // [stage solve]
-
-// A process without contacts of its own still takes part in the iterations of the others (chapter
-// 8): its velocity hook and its global verdict are collective. Each iteration it offers its
-// velocities (a split body's copies elsewhere may change them) and the verdict "converged" once
-// min_iterations are done, until every process agrees to stop.
-void MoreauStepper::take_part_without_contacts(StepReport& report) {
-  const contact::SolverHooks& h = hooks_.solver;
-  for (int k = 1; k <= settings_.solver.max_iterations; ++k) {
-    if (h.velocities_between_sweeps) h.velocities_between_sweeps(k, solution_.u);
-    const contact::IterationStatus local = k >= settings_.solver.min_iterations
-                                               ? contact::IterationStatus::converged
-                                               : contact::IterationStatus::running;
-    const contact::IterationStatus global = h.global_status(local);
-    report.iterations = k;
-    if (global == contact::IterationStatus::diverged) {
-      throw Error("MoreauStepper: step " + std::to_string(report.step) + " (t = " +
-                  format_number(report.t) + " s): the contact solver diverged on another process");
-    }
-    if (global == contact::IterationStatus::converged) return;
-  }
-  report.converged = false;
-  ++non_converged_;
-}
 
 // [stage finish]
 // 5. u_E back in the body frames, q_E = q_M + Δt/2 F(q_M) u_E, the warm starts kept, the

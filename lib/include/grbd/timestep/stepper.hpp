@@ -217,7 +217,6 @@ class MoreauStepper {
   Vector7 half(const Vector7& q, const Vector6& u) const;
   void check_layout();
   void correct_drift();
-  void take_part_without_contacts(StepReport& report);
   [[noreturn]] void require_finite(const StepReport& report, const char* where) const;
 
   BodySystem& system_;
