@@ -88,7 +88,8 @@ constexpr const char* kInfoExitCodes =
     "Exit codes: 0 done; 2 bad command line; 3 not a readable grbd output file.";
 constexpr const char* kChuteExitCodes =
     "Exit codes: 0 done; 1 the CSV could not be written; 2 bad command line (also a --csv that is "
-    "the output, its XDMF or scene, a folder, a device or FIFO, a read-only file); 3 not a "
+    "the output, its XDMF or scene, a folder, a device or FIFO, a read-only file or a file that is "
+    "not an earlier table of grbd chute); 3 not a "
     "readable grbd output file (or one a run is writing).";
 constexpr const char* kFclibExitCodes =
     "Exit codes: 0 every problem was solved (converged or not: the table says); 1 the CSV could "
@@ -377,9 +378,13 @@ int info_command(const std::string& file) {
   }
 }
 
+// The first line of grbd chute's table.
+constexpr const char* kChuteCsvHeader = "t_s,bodies,flow_count,front_m";
+
 // Why `csv` cannot take grbd chute's table ("" when it can): it is the output read, its XDMF or
 // the scene that made it, an existing file that is not a regular one (a folder, a device, a FIFO)
-// or not writable, or a name in a folder that does not exist. The CSV replaces only a regular file.
+// or not writable, a file that is not an earlier table of grbd chute, or a name in a folder that
+// does not exist. The CSV replaces only an earlier table (or an empty regular file).
 std::string csv_problem(const std::string& csv, const std::string& output,
                         const std::string& scene_file) {
   namespace fs = std::filesystem;
@@ -408,6 +413,14 @@ std::string csv_problem(const std::string& csv, const std::string& output,
       return quoted + " is not a regular file (a device, a FIFO or a socket): give a file name";
     }
     if (::access(csv.c_str(), W_OK) != 0) return quoted + " is read-only: it is not replaced";
+    // Only an earlier table of grbd chute is replaced (or an empty file), never another file.
+    std::ifstream in(target);
+    std::string first;
+    std::getline(in, first);
+    if (fs::file_size(target, error) > 0 && first != kChuteCsvHeader) {
+      return quoted + " exists and is not a table of grbd chute (its first line is not \"" +
+             std::string(kChuteCsvHeader) + "\"): give another name, or remove it first";
+    }
   }
   if (::access(folder.c_str(), W_OK | X_OK) != 0) {
     return quoted + ": the folder \"" + folder.string() + "\" is not writable";
@@ -442,7 +455,7 @@ int chute_command(const std::string& file, const std::optional<std::string>& csv
       const std::filesystem::path temporary = *csv + ".tmp";
       {
         std::ofstream out(temporary);
-        out << "t_s,bodies,flow_count,front_m\n" << std::setprecision(9);
+        out << kChuteCsvHeader << '\n' << std::setprecision(9);
         for (std::size_t k = 0; k < t.size(); ++k) {
           out << t[k] << ',' << bodies[k] << ',' << count[k] << ',' << fronts[k] << '\n';
         }
@@ -708,7 +721,9 @@ int grbd_main(int argc, char** argv) {
   chute->add_option("output", chute_file, "The HDF5 output of grbd run")
       ->required()
       ->check(CLI::ExistingFile);
-  chute->add_option("--csv", chute_csv, "Also write t, bodies, flow count and front per record");
+  chute->add_option("--csv", chute_csv,
+                    "Also write t, bodies, flow count and front per record (replaces only an "
+                    "earlier table of grbd chute)");
   // The numbers of the scene files' rules (scene::parse_real: decimal, no hexadecimal, no
   // spaces), finite and in range; the range named in plain words.
   const auto real_in = [](bool (*in_range)(double), const std::string& range) {

@@ -245,8 +245,10 @@ class Faults(unittest.TestCase):
         with open(self.path("earlier.csv"), "w") as f:
             f.write("an earlier result\n")
         os.chmod(self.path("earlier.csv"), 0o444)
+        shutil.copy(self.scene, self.path("copy.toml"))  # a file of the user's, not a table
         bad = [out, os.path.join(self.dir, ".", "o.h5"), self.path("o.xmf"), self.scene,
-               self.path("fifo"), self.path("folder"), "", self.path("none/flow.csv")]
+               self.path("fifo"), self.path("folder"), "", self.path("none/flow.csv"),
+               self.path("copy.toml")]
         if os.geteuid() != 0:  # root writes a read-only file all the same
             bad.append(self.path("earlier.csv"))
         for csv in bad:
@@ -257,9 +259,13 @@ class Faults(unittest.TestCase):
             self.assertEqual(os.path.getsize(out), size)
         self.assertTrue(os.path.exists(self.scene))
         self.assertFalse(os.path.isfile(self.path("fifo")))
-        result = grbd(0, "chute", out, "--csv", self.path("flow.csv"))
-        self.assertEqual(result.returncode, 0, result.stderr)
-        self.assertTrue(os.path.isfile(self.path("flow.csv")))
+        with open(self.path("copy.toml")) as f, open(self.scene) as g:
+            self.assertEqual(f.read(), g.read())
+        for _ in range(2):  # a new table, then the earlier table replaced
+            result = grbd(0, "chute", out, "--csv", self.path("flow.csv"))
+            self.assertEqual(result.returncode, 0, result.stderr)
+            with open(self.path("flow.csv")) as f:
+                self.assertEqual(f.readline(), "t_s,bodies,flow_count,front_m\n")
         # Numbers as the scene files write them: no hexadecimal, no spaces; a range in words.
         for option in (["--kink", "0x10"], ["--entry", " 0x10"], ["--entry", "1e-320"],
                        ["--entry", "0"], ["--kink", "nan"]):

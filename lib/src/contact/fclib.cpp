@@ -40,7 +40,7 @@
 #include <system_error>
 #include <utility>
 
-#include "core/hdf5.hpp"
+#include "shared/hdf5.hpp"
 #include "grbd/core/checks.hpp"
 #include "grbd/core/error.hpp"
 

@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-#include "core/hdf5.hpp"
+#include "shared/hdf5.hpp"
 #include "grbd/core/communicator.hpp"
 #include "grbd/io/output.hpp"
 #include "grbd/timestep/body_record.hpp"

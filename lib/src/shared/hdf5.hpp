@@ -1,5 +1,7 @@
 #pragma once
-// The parts of HDF5's C API that every grbd reader and writer needs (private to the library):
+// The parts of HDF5's C API that every grbd reader and writer needs (private to the library, and
+// of no module: lib/src/shared/ holds what several modules' implementations share — here chapter
+// 5's FCLIB reader and chapter 7's output and checkpoints):
 // handles closed by RAII, a switch for HDF5's own printing of its error stack, the innermost HDF5
 // message for grbd's errors, and the mutex that serializes calls into an HDF5 that is not built
 // thread-safe.
