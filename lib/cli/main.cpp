@@ -219,6 +219,19 @@ void same_as_rank_0(const grbd::Communicator& world, const grbd::scene::Scene& s
       ": every process of a run must be given the same scene and options");
 }
 
+// Each line of `text` indented by two spaces.
+std::string indented(const std::string& text) {
+  std::string out;
+  std::size_t from = 0;
+  while (from < text.size()) {
+    const std::size_t end = text.find('\n', from);
+    const std::size_t to = end == std::string::npos ? text.size() : end + 1;
+    out += "  " + text.substr(from, to - from);
+    from = to;
+  }
+  return out;
+}
+
 int run_command(const std::string& scene_file, const std::optional<std::string>& output,
                 const std::optional<std::string>& checkpoint,
                 const std::optional<std::string>& restart,
@@ -314,7 +327,8 @@ int run_command(const std::string& scene_file, const std::optional<std::string>&
               << (result.rebalances > 0 ? ", " + std::to_string(result.rebalances) + " rebalances"
                                         : "")
               << "), " << result.records << " records in " << options.output.string()
-              << ", checkpoint " << options.checkpoint.string() << '\n';
+              << ", checkpoint " << options.checkpoint.string() << '\n'
+              << indented(result.accuracy.describe());
   }
   if (result.stop_file) return kExitStopFile;
   if (result.interrupted) return 128 + static_cast<int>(g_signal);
@@ -362,15 +376,14 @@ int info_command(const std::string& file) {
                 << " bodies in the last";
     }
     std::cout << "\n  steps: " << s.steps << ", wall time " << s.seconds << " s\n"
-              << "  solver: mean " << s.mean_iterations << " iterations, at most "
-              << s.max_iterations << ", " << s.non_converged << " steps not converged";
+              << "  contacts: at most " << s.max_contacts << "\n";
     if (s.non_converged > 0) {
-      std::cout << " (they stopped at the cap of " << s.non_converged_iterations
-                << " iterations, [solver] max_iterations, before the tolerance)";
+      std::cout << "  " << s.non_converged << " steps stopped at the cap of "
+                << s.non_converged_iterations
+                << " iterations ([solver] max_iterations) before the tolerance\n";
     }
-    std::cout << "\n"
-              << "  contacts: at most " << s.max_contacts << ", largest penetration "
-              << s.max_penetration << " m\n";
+    std::cout
+              << indented(s.accuracy.describe());
     return 0;
   } catch (const grbd::Error& e) {
     std::cerr << "grbd info: " << e.what() << '\n';

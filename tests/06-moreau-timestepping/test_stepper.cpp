@@ -41,7 +41,7 @@ struct Bounce {
   double worst_gain = 0.0;
 };
 
-Bounce bounce(double eps, double dt, double t_end) {
+Bounce bounce(double eps, double dt, double t_end, double overlap_recovery = 0.0) {
   BodySystem system;
   const double r = 0.1;
   const double h0 = 1.0;
@@ -49,7 +49,9 @@ Bounce bounce(double eps, double dt, double t_end) {
   StaticGeometry statics;
   statics.add(demo::floor_object());
   const MaterialTable materials = demo::one_material(0.3, eps);
-  MoreauStepper stepper(system, statics, materials, tight(dt));
+  StepSettings settings = tight(dt);
+  settings.overlap_recovery = overlap_recovery;
+  MoreauStepper stepper(system, statics, materials, settings);
   Bounce result;
   double energy = mechanical_energy(system.inertia(), system.states(), stepper.settings().I_g);
   const double scale = std::abs(energy);
@@ -681,6 +683,14 @@ TEST(Stepper, RefusesBadSettingsMissingMaterialPairsAndUnsupportedShapePairs) {
   bad.drift_correction = 2.0;
   EXPECT_THROW(MoreauStepper(system, statics, materials, bad), InvalidArgument);
   bad = {};
+  bad.overlap_recovery = -0.1;
+  EXPECT_THROW(MoreauStepper(system, statics, materials, bad), InvalidArgument);
+  bad = {};
+  bad.max_recovery_speed = 0.0;
+  EXPECT_THROW(MoreauStepper(system, statics, materials, bad), InvalidArgument);
+  bad.max_recovery_speed = std::nan("");
+  EXPECT_THROW(MoreauStepper(system, statics, materials, bad), InvalidArgument);
+  bad = {};
   bad.skin = -1e-3;
   EXPECT_THROW(MoreauStepper(system, statics, materials, bad), InvalidArgument);
   materials.set_pair(1, 1, {0.5, 0.0, 0.0});
@@ -858,6 +868,138 @@ TEST(DriftCorrection, OffKeepsOverlapsOnRemovesThemGeometricallyWithoutVelocity)
     previous = now;
   }
   EXPECT_LT(previous, 5e-5);  // the overlaps diffuse through the column: 300 steps remove 3/4
+}
+
+// ---------------------------------------------------------------------------------------------
+// The gap-aware normal law (chapter 6, "The gap-aware normal law"): γ_N,E ≥ max(−ε_N γ_N,S, v_R),
+// v_R = min(β_g 2|g_N(q_M)|/Δt, v_max) for a contact overlapping at the midpoint.
+
+// A sphere at rest δ₀ = (N − ½) v_max Δt into the floor, β_g = 1: while the uncapped recovery
+// exceeds the cap, each step leaves the contact opening at exactly v_max (gravity keeps the law
+// binding), so the midpoint overlap of step k is δ₀ − (k − 1) v_max Δt; step N ends with the
+// overlap gone, step N + 1 has no overlap, and from then on the energy above rest never exceeds
+// the bound ½ m v_max² (the hop of a body the law pushed out).
+TEST(GapLaw, ASphereInTheFloorRisesAtTheCapLeavesInThePredictedStepAndGainsAtMostHalfMVSquared) {
+  const double r = 0.01;
+  const double dt = 1e-3;
+  const int N = 10;
+  const double delta0 = 1e-4;
+  const double v_max = delta0 / ((N - 0.5) * dt);
+  BodySystem system;
+  StaticGeometry statics;
+  statics.add(demo::floor_object());
+  system.add(sphere_body(1, r, Vector3(0.0, 0.0, r - delta0)));
+  const MaterialTable materials = demo::one_material(0.5);
+  StepSettings settings = tight(dt);
+  settings.overlap_recovery = 1.0;
+  settings.max_recovery_speed = v_max;
+  MoreauStepper stepper(system, statics, materials, settings);
+  const double m = system.inertia()[0].m;
+  for (int k = 1; k <= N; ++k) {
+    const StepReport report = stepper.step();
+    ASSERT_EQ(report.contacts, 1u) << "step " << k;
+    EXPECT_NEAR(report.max_penetration, delta0 - (k - 1) * v_max * dt, 1e-12) << "step " << k;
+    EXPECT_NEAR(system.states()[0].u.z(), v_max, 1e-9 * v_max) << "step " << k;
+  }
+  EXPECT_NEAR(system.states()[0].q.z(), r, 1e-12) << "the overlap is gone after N steps";
+  EXPECT_EQ(stepper.step().max_penetration, 0.0) << "step N + 1 overlaps no more";
+  // Without the law the overlap stays (Penetration drift); with it, the hops that follow gain
+  // nothing beyond ½ m v_max² and never overlap by more than a landing's (v_max + g Δt) Δt.
+  const double bound = 0.5 * m * v_max * v_max;
+  for (int k = 0; k < 2000; ++k) {
+    const StepReport report = stepper.step();
+    const double above_rest = report.kinetic_energy + report.potential_energy - m * kG * r;
+    ASSERT_LE(above_rest, bound * (1.0 + 1e-9)) << "step " << k;
+    ASSERT_LE(report.max_penetration, (v_max + kG * dt) * dt) << "step " << k;
+  }
+}
+
+// A column of five spheres overlapping by δ₀ each: every contact binds at the cap, so every
+// overlap shrinks by v_max Δt a step, all at once, and all are gone after N steps.
+TEST(GapLaw, AColumnOfOverlapsOpensContactByContactAtTheCap) {
+  const double r = 0.01;
+  const double dt = 1e-3;
+  const int N = 10;
+  const double delta0 = 2e-4;
+  const double v_max = delta0 / ((N - 0.5) * dt);
+  BodySystem system;
+  StaticGeometry statics;
+  statics.add(demo::floor_object());
+  for (int i = 0; i < 5; ++i) {
+    system.add(sphere_body(static_cast<GlobalId>(i + 1), r,
+                           Vector3(0.0, 0.0, r - delta0 + (2.0 * r - delta0) * i)));
+  }
+  const MaterialTable materials = demo::one_material(0.5);
+  StepSettings settings = tight(dt);
+  settings.overlap_recovery = 1.0;
+  settings.max_recovery_speed = v_max;
+  MoreauStepper stepper(system, statics, materials, settings);
+  for (int k = 1; k <= N; ++k) {
+    const StepReport report = stepper.step();
+    ASSERT_EQ(report.contacts, 5u) << "step " << k;
+    EXPECT_NEAR(report.max_penetration, delta0 - (k - 1) * v_max * dt, 1e-11) << "step " << k;
+    EXPECT_NEAR(report.mean_penetration, delta0 - (k - 1) * v_max * dt, 1e-11) << "step " << k;
+    for (int i = 0; i < 5; ++i) {
+      EXPECT_NEAR(system.states()[static_cast<std::size_t>(i)].u.z(), (i + 1) * v_max, 1e-8 * v_max)
+          << "step " << k << ", sphere " << i + 1;
+    }
+  }
+  EXPECT_EQ(stepper.step().max_penetration, 0.0);
+}
+
+// Impacts: the overlap at the midpoint of a first contact is less than |γ_N,S| Δt, so with
+// β_g ≤ ε_N/2 the recovery speed stays below the restituted one and the law leaves the bouncing
+// ball's impacts exactly as Moreau's law gives them (t_k of the closed form, Bouncing ball).
+TEST(GapLaw, WithBetaAtMostHalfEpsilonTheBouncingBallsImpactsAreUnchanged) {
+  const double dt = 1e-3;
+  const double eps = 0.8;
+  const double zeno = bouncing_ball_zeno_time(1.0, kG, eps);
+  const Bounce off = bounce(eps, dt, zeno - 0.05);
+  const Bounce on = bounce(eps, dt, zeno - 0.05, 0.5 * eps);
+  ASSERT_GE(off.impacts.size(), 8u);
+  EXPECT_EQ(on.impacts, off.impacts);
+  EXPECT_FALSE(on.energy_increased) << "relative gain " << on.worst_gain;
+}
+
+// The overlaps' histogram (Accuracy of a step): bins of 10^(1/20) from 1e-8 r to r, quantiles
+// read as the upper edge of their bin — never below the exact quantile, at most 12 % above it —
+// and counts that add exactly (over steps, over processes).
+TEST(OverlapHistogram, BinsQuantilesAndSumsAgainstTheSortedOverlaps) {
+  using H = OverlapHistogram;
+  EXPECT_EQ(H::bin(0.0), 0);
+  EXPECT_EQ(H::bin(0.9e-8), 0);
+  EXPECT_EQ(H::bin(std::nan("")), 0);
+  EXPECT_EQ(H::bin(1e-8), 1);
+  EXPECT_EQ(H::bin(0.999), H::kBins - 2);
+  EXPECT_EQ(H::bin(1.0), H::kBins - 1);
+  EXPECT_NEAR(H::upper_edge(H::kBins - 2), 1.0, 1e-15);
+  EXPECT_EQ(H::upper_edge(H::kBins - 1), std::numeric_limits<double>::infinity());
+  for (int b = 1; b < H::kBins - 1; ++b) {  // every bin holds what its edges say
+    const double lo = H::upper_edge(b - 1) * (b == 1 ? 1.0 : 1.0 + 1e-12);
+    EXPECT_EQ(H::bin(lo), b) << b;
+    EXPECT_EQ(H::bin(H::upper_edge(b) * (1.0 - 1e-12)), b) << b;
+  }
+  std::mt19937_64 rng(3);
+  std::lognormal_distribution<double> overlap(std::log(1e-3), 1.5);
+  const double r = 1e-3;
+  std::vector<double> all;
+  H first, second;
+  for (int k = 0; k < 20000; ++k) {
+    const double d = r * std::min(overlap(rng), 0.5);
+    all.push_back(d);
+    (k % 3 == 0 ? first : second).add(d, r);
+  }
+  H both = first;
+  both.add(second);
+  EXPECT_EQ(both.count(), all.size());
+  std::sort(all.begin(), all.end());
+  for (const double p : {0.5, 0.9, 0.99, 0.999}) {
+    const double exact = all[static_cast<std::size_t>(std::ceil(p * all.size())) - 1] / r;
+    const double read = both.quantile(p);
+    EXPECT_GE(read, exact) << p;
+    EXPECT_LE(read, exact * std::pow(10.0, 1.0 / H::kPerDecade) * (1.0 + 1e-12)) << p;
+  }
+  EXPECT_EQ(H{}.quantile(0.99), 0.0);
 }
 
 }  // namespace

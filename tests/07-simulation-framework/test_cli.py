@@ -7,6 +7,7 @@ of an uninterrupted run of the same scene: the records, the per-step table (all 
 times), the body table and the materials must be bit-identical.
 """
 
+import math
 import os
 import random
 import re
@@ -226,9 +227,32 @@ class Output(Scratch):
             steps = f["steps"][()]
         stopped = steps[steps["converged"] == 0]
         self.assertGreater(len(stopped), 0)  # the chute's solver is capped at 300 iterations
-        self.assertIn(f"{len(stopped)} steps not converged (they stopped at the cap of "
+        self.assertIn(f"{len(stopped)} steps stopped at the cap of "
                       f"{int(stopped['iterations'].max())} iterations", result.stdout)
         self.assertEqual(int(stopped["iterations"].max()), 300)
+        # The accuracy of the run (chapter 6), recomputed here from the file's own tables: the
+        # share of steps converged and the sweeps from /steps, the overlaps' mean weighted by the
+        # contacts of each step, their largest, and the 99th percentile of the records' histograms
+        # (the upper edge of the bin holding it, 20 bins a decade above 1e-8 r).
+        with h5py.File(out, "r") as f:
+            table = f["records/overlaps"]
+            counts = table[()].sum(axis=0)
+            unit = float(table.attrs["unit"])
+        n = len(steps)
+        converged = int(steps["converged"].sum())
+        self.assertIn(f"solver: {converged} of {n} steps converged "
+                      f"({100.0 * converged / n:.3g} %), sweeps a step: mean "
+                      f"{steps['iterations'].mean():.3g}, largest {int(steps['iterations'].max())}",
+                      result.stdout)
+        mean = float((steps["mean_penetration"] * steps["contacts"]).sum() / steps["contacts"].sum())
+        largest = float(steps["max_penetration"].max())
+        need = max(1, math.ceil(0.99 * counts.sum()))
+        b = int(np.argmax(np.cumsum(counts) >= need))
+        p99 = 10.0 ** (-8 + b / 20) * unit
+        self.assertIn(f"overlaps: mean {mean:.3g} m ({mean / unit:.3g} r), 99th percentile "
+                      f"{p99:.3g} m ({p99 / unit:.3g} r) (at the records), largest {largest:.3g} m",
+                      result.stdout)
+        self.assertGreater(largest, 0.0)
 
     def test_float32_records_on_request(self):
         with open(SCENE) as f:

@@ -187,6 +187,26 @@ TEST(SceneFile, OutOfRangeValuesNameTheKeyTheRangeAndTheValue) {
       "(did you mean \"sor\"?), found the string \"sore\"");
 }
 
+// The gap-aware normal law's keys (chapter 6) reach the stepper's settings; bad values are
+// refused by name.
+TEST(SceneFile, TheGapAwareLawIsASceneKey) {
+  const Scene scene = parse_scene(
+      replace(kMinimal, "[simulation]",
+              "[solver]\noverlap_recovery = 0.5\nmax_recovery_speed = 0.02\n[simulation]"),
+      "scene.toml");
+  EXPECT_EQ(scene.settings.overlap_recovery, 0.5);
+  EXPECT_EQ(scene.settings.max_recovery_speed, 0.02);
+  EXPECT_EQ(error_of(replace(kMinimal, "[simulation]", "[solver]\noverlap_recovery = 1.5\n[simulation]")),
+            "scene.toml:2:20: solver.overlap_recovery: expected a number in [0, 1], found the "
+            "number 1.5");
+  EXPECT_NE(error_of(replace(kMinimal, "[simulation]", "[solver]\nmax_recovery_speed = 0\n[simulation]"))
+                .find("solver.max_recovery_speed: expected a number > 0"),
+            std::string::npos);
+  EXPECT_NE(error_of(replace(kMinimal, "[simulation]", "[solver]\nmax_recovery_speed = nan\n[simulation]"))
+                .find("solver.max_recovery_speed: expected a number > 0"),
+            std::string::npos);
+}
+
 // Newton's keys reach the stepper's settings, and bad values are refused by name.
 TEST(SceneFile, NewtonsLinearSolverAndHybridAreSceneKeys) {
   const Scene scene = parse_scene(

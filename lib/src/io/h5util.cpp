@@ -66,6 +66,7 @@ Handle step_row_type() {
   H5Tinsert(type.get(), "potential_energy", HOFFSET(StepRow, potential_energy), H5T_NATIVE_DOUBLE);
   H5Tinsert(type.get(), "max_penetration", HOFFSET(StepRow, max_penetration), H5T_NATIVE_DOUBLE);
   H5Tinsert(type.get(), "mean_penetration", HOFFSET(StepRow, mean_penetration), H5T_NATIVE_DOUBLE);
+  H5Tinsert(type.get(), "p99_penetration", HOFFSET(StepRow, p99_penetration), H5T_NATIVE_DOUBLE);
   H5Tinsert(type.get(), "seconds_midpoint", HOFFSET(StepRow, seconds_midpoint), H5T_NATIVE_DOUBLE);
   H5Tinsert(type.get(), "seconds_detection", HOFFSET(StepRow, seconds_detection),
             H5T_NATIVE_DOUBLE);

@@ -57,6 +57,7 @@ struct StepRow {
   double potential_energy;
   double max_penetration;
   double mean_penetration;
+  double p99_penetration;
   double seconds_midpoint;
   double seconds_detection;
   double seconds_assembly;

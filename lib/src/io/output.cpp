@@ -115,13 +115,16 @@ void check_bodies(hid_t root, const std::string& file, std::uint64_t rows,
       h5::fail(file, "dataset bodies, row " + std::to_string(i) + ": " + e.what());
     }
   }
-  std::sort(
-      table.begin(), table.end(),
-      [](const timestep::BodyRecord& a, const timestep::BodyRecord& b) { return a.id < b.id; });
+  // Rows by id (an index, not the records themselves: moving the records' shape variants inside
+  // std::sort trips GCC 12's -Wmaybe-uninitialized).
+  std::vector<std::pair<std::uint64_t, std::size_t>> by_id(table.size());
+  for (std::size_t i = 0; i < table.size(); ++i) by_id[i] = {table[i].id, i};
+  std::sort(by_id.begin(), by_id.end());
   for (const timestep::BodyRecord& body : bodies) {
-    const auto it = std::lower_bound(
-        table.begin(), table.end(), body.id,
-        [](const timestep::BodyRecord& row, std::uint64_t id) { return row.id < id; });
+    const auto found = std::lower_bound(by_id.begin(), by_id.end(),
+                                        std::pair<std::uint64_t, std::size_t>{body.id, 0});
+    const auto it = found == by_id.end() ? table.end()
+                                         : table.begin() + static_cast<std::ptrdiff_t>(found->second);
     if (it == table.end() || it->id != body.id || !timestep::same_constants(*it, body)) {
       h5::fail(file, "belongs to another run: the body with id " + std::to_string(body.id) +
                          " of the checkpoint is " +
@@ -205,6 +208,10 @@ std::size_t first_different_line(std::string_view a, std::string_view b) {
   return line;
 }
 
+Handle overlap_row_type();
+void read_row(hid_t table, hid_t type, std::uint64_t index, void* out, const std::string& file);
+void describe_overlaps(hid_t table, double unit, const std::string& file);
+
 struct OutputFile::Impl {
   std::unique_ptr<h5::FileLock> lock;  // first: released after every handle is closed
   const Communicator* comm = nullptr;  // the processes that write the file together
@@ -220,6 +227,9 @@ struct OutputFile::Impl {
   Handle record_step;
   Handle record_bodies;
   Handle record_contacts;  // with [output] contacts: the contacts of each record
+  Handle record_overlaps;  // the overlaps' histogram of each record's last step (none: older files)
+  Handle overlaps_type = overlap_row_type();
+  timestep::OverlapHistogram last_overlaps;  // of the last step added
   bool contacts = false;
   Handle body_type = h5::body_row_type();
   Handle step_type = h5::step_row_type();
@@ -238,7 +248,7 @@ struct OutputFile::Impl {
   bool root() const { return comm->rank() == 0; }
   // Every handle of the file, innermost first.
   void close_handles() {
-    for (Handle* h : {&record_contacts, &record_bodies, &record_step, &record_time, &records,
+    for (Handle* h : {&record_overlaps, &record_contacts, &record_bodies, &record_step, &record_time, &records,
                       &steps, &bodies}) {
       h->close();
     }
@@ -249,6 +259,40 @@ struct OutputFile::Impl {
   std::vector<std::uint64_t> ids;
   std::vector<double> r, p, v, w, radius;
 };
+
+// A row of /records/overlaps: the counts of an OverlapHistogram.
+Handle overlap_row_type() {
+  const hsize_t bins = timestep::OverlapHistogram::kBins;
+  return Handle(H5Tarray_create2(H5T_STD_U64LE, 1, &bins), H5Tclose);
+}
+
+// Reads row `index` of the 1-D dataset `table` as `type` into `out`.
+void read_row(hid_t table, hid_t type, std::uint64_t index, void* out, const std::string& file) {
+  Handle space = check(H5Dget_space(table), H5Sclose, file, "cannot read a dataset's shape");
+  const hsize_t first = index, one = 1;
+  check(H5Sselect_hyperslab(space.get(), H5S_SELECT_SET, &first, nullptr, &one, nullptr), file,
+        "cannot select a row");
+  Handle memory = check(H5Screate_simple(1, &one, nullptr), H5Sclose, file,
+                        "cannot create a dataspace");
+  check(H5Dread(table, type, memory.get(), space.get(), H5P_DEFAULT, out), file,
+        "cannot read a row");
+}
+
+// What a reader needs to turn the counts into overlaps: the unit r and the bins' edges.
+void describe_overlaps(hid_t table, double unit, const std::string& file) {
+  using H = timestep::OverlapHistogram;
+  h5::write_attribute(table, "unit", unit, file);
+  h5::write_attribute(table, "bins_per_decade", std::uint64_t{H::kPerDecade}, file);
+  h5::write_attribute(table, "decades", std::uint64_t{H::kDecades}, file);
+  h5::write_attribute(
+      table, "description",
+      std::string("counts of the overlaps d = max(0, -g_N) of the contacts at the midpoint of "
+                  "the record's last step (a fresh run's first record: none), in bins of d/unit "
+                  "(unit: m, the smallest radius of the scene): bin 0 d/unit < 1e-8, bin b in "
+                  "1 ... 20*decades: 10^(-8+(b-1)/20) <= d/unit < 10^(-8+b/20), the last bin "
+                  "d/unit >= 1"),
+      file);
+}
 
 std::filesystem::path OutputFile::xdmf_path(const std::filesystem::path& path) {
   std::filesystem::path xdmf = path;
@@ -313,6 +357,9 @@ void OutputFile::share() {
     o.record_step = open_dataset(o.records.get(), "step", o.file);
     o.record_bodies = open_dataset(o.records.get(), "bodies", o.file);
     if (o.contacts) o.record_contacts = open_dataset(o.records.get(), "contacts", o.file);
+    if (H5Lexists(o.records.get(), "overlaps", H5P_DEFAULT) > 0) {  // none in earlier versions
+      o.record_overlaps = open_dataset(o.records.get(), "overlaps", o.file);
+    }
   });
 }
 // [share output]
@@ -357,6 +404,9 @@ void OutputFile::create(const scene::Scene& scene) {
     o.record_contacts = h5::create_table(o.records.get(), "contacts", H5T_STD_U64LE, 256, o.file);
     h5::describe(o.records.get(), "contacts", "1", nullptr, o.file);
   }
+  o.record_overlaps =
+      h5::create_table(o.records.get(), "overlaps", o.overlaps_type.get(), 256, o.file);
+  describe_overlaps(o.record_overlaps.get(), scene.settings.tolerance_radius, o.file);
   h5::describe(o.records.get(), "time", "s", nullptr, o.file);
   h5::describe(o.records.get(), "step", "1", nullptr, o.file);
   h5::describe(o.records.get(), "bodies", "1", nullptr, o.file);
@@ -370,7 +420,9 @@ void OutputFile::create(const scene::Scene& scene) {
   h5::write_attribute(o.steps.get(), "units",
                       std::string("step: 1; t: s; bodies, contacts, warm_started, iterations: 1; "
                                   "converged: 0 or 1; residual: natural map (chapter 5); "
-                                  "kinetic_energy, potential_energy: J; max_penetration, mean_penetration: m; "
+                                  "kinetic_energy, potential_energy: J; max_penetration, mean_penetration, "
+                                  "p99_penetration (the upper edge of its bin of /records/overlaps' "
+                                  "scale, at most 12 % above): m; "
                                   "seconds_*: s of wall time"),
                       o.file);
   const StaticSurface surface = write_static(root, scene, o.file);
@@ -417,6 +469,29 @@ void OutputFile::reopen(const scene::Scene& scene, const OutputPosition& at,
                          "contacts)");
   }
   if (o.contacts) o.record_contacts = open_dataset(o.records.get(), "contacts", o.file);
+  if (H5Lexists(o.records.get(), "overlaps", H5P_DEFAULT) > 0) {  // outputs of earlier versions
+    o.record_overlaps = open_dataset(o.records.get(), "overlaps", o.file);
+    if (h5::rows(o.record_overlaps.get(), o.file, "records/overlaps") < at.records) {
+      h5::fail(o.file, "holds less than the checkpoint counts in records/overlaps: it is not "
+                       "this run's output");
+    }
+    // The record after the checkpoint's (an extra last record at the checkpoint's step) is written
+    // again before any step of this run: it keeps the histogram of the step it was taken after.
+    if (at.steps > 0 &&
+        h5::rows(o.record_overlaps.get(), o.file, "records/overlaps") > at.records &&
+        h5::rows(o.record_step.get(), o.file, "records/step") > at.records) {
+      std::uint64_t record_step = 0;
+      h5::StepRow last{};
+      Handle step_type = h5::step_row_type();
+      read_row(o.record_step.get(), H5T_NATIVE_UINT64, at.records, &record_step, o.file);
+      read_row(o.steps.get(), step_type.get(), at.steps - 1, &last, o.file);
+      if (record_step == last.step) {
+        read_row(o.record_overlaps.get(), o.overlaps_type.get(), at.records,
+                 o.last_overlaps.counts().data(), o.file);
+      }
+    }
+    h5::resize(o.record_overlaps.get(), at.records, o.file, "records/overlaps");
+  }
   const std::uint64_t count = h5::read_uint(o.records.get(), "count", o.file);
   if (count < at.records || h5::rows(o.steps.get(), o.file, "steps") < at.steps ||
       h5::rows(o.bodies.get(), o.file, "bodies") < at.bodies ||
@@ -486,6 +561,7 @@ void OutputFile::add_step(const timestep::StepReport& report, std::size_t bodies
   row.potential_energy = report.potential_energy;
   row.max_penetration = report.max_penetration;
   row.mean_penetration = report.mean_penetration;
+  row.p99_penetration = report.p99_penetration;
   row.seconds_midpoint = report.seconds.midpoint;
   row.seconds_detection = report.seconds.detection;
   row.seconds_assembly = report.seconds.assembly;
@@ -493,6 +569,7 @@ void OutputFile::add_step(const timestep::StepReport& report, std::size_t bodies
   row.seconds_update = report.seconds.update;
   row.seconds_total = report.seconds.total;
   impl_->pending_steps.push_back(row);
+  impl_->last_overlaps = report.overlaps;
 }
 
 void OutputFile::write_bodies(std::vector<timestep::BodyRecord>& created) {
@@ -664,6 +741,10 @@ void OutputFile::write_record(double t, std::uint64_t step, RecordPart& part) {
   set_row(o.record_bodies.get(), H5T_NATIVE_UINT64, &count, "records/bodies");
   if (o.contacts)
     set_row(o.record_contacts.get(), H5T_NATIVE_UINT64, &contacts, "records/contacts");
+  if (o.record_overlaps.valid()) {
+    set_row(o.record_overlaps.get(), o.overlaps_type.get(), o.last_overlaps.counts().data(),
+            "records/overlaps");
+  }
   // Everything of the record on disk first, then the count that makes it part of the file.
   check(H5Fflush(o.handle.get(), H5F_SCOPE_LOCAL), o.file, "cannot flush");
   h5::write_attribute(o.records.get(), "count", index + 1, o.file);
@@ -915,8 +996,8 @@ std::vector<StepInfo> step_infos(hid_t root, const std::string& file) {
   steps.reserve(rows.size());
   for (const h5::StepRow& row : rows) {
     steps.push_back({row.step, row.t, row.bodies, row.contacts, row.iterations, row.converged != 0,
-                     row.residual, row.max_penetration, row.mean_penetration, row.kinetic_energy,
-                     row.seconds_total});
+                     row.residual, row.max_penetration, row.mean_penetration,
+                     row.p99_penetration, row.kinetic_energy, row.seconds_total});
   }
   return steps;
 }
@@ -958,6 +1039,40 @@ OutputSummary read_summary(const std::filesystem::path& path) {
     s.seconds += row.seconds;
   }
   if (!steps.empty()) s.mean_iterations = iterations / static_cast<double>(steps.size());
+  RunAccuracy& a = s.accuracy;
+  for (const StepInfo& row : steps) {
+    ++a.steps;
+    a.converged += row.converged ? 1 : 0;
+    a.sweeps += static_cast<std::uint64_t>(std::max(row.iterations, 0));
+    a.max_sweeps = std::max<std::uint64_t>(a.max_sweeps, static_cast<std::uint64_t>(std::max(row.iterations, 0)));
+    a.max_residual = std::max(a.max_residual, row.residual);
+    a.contacts += row.contacts;
+    a.overlap_sum += row.mean_penetration * static_cast<double>(row.contacts);
+    a.max_overlap = std::max(a.max_overlap, row.max_penetration);
+  }
+  if (H5Lexists(records.get(), "overlaps", H5P_DEFAULT) > 0) {
+    Handle table = open_dataset(records.get(), "overlaps", file);
+    a.unit = h5::read_double(table.get(), "unit", file);
+    constexpr int kBins = timestep::OverlapHistogram::kBins;
+    const hsize_t n = s.records;
+    if (h5::rows(table.get(), file, "records/overlaps") < n) {
+      h5::fail(file, "records/overlaps holds fewer rows than records@count");
+    }
+    std::vector<std::uint64_t> counts(n * kBins);
+    if (n > 0) {
+      Handle type = overlap_row_type();
+      Handle space = check(H5Dget_space(table.get()), H5Sclose, file, "cannot read records/overlaps");
+      const hsize_t first = 0;
+      check(H5Sselect_hyperslab(space.get(), H5S_SELECT_SET, &first, nullptr, &n, nullptr), file,
+            "cannot select records/overlaps");
+      Handle memory = check(H5Screate_simple(1, &n, nullptr), H5Sclose, file,
+                            "cannot create a dataspace");
+      check(H5Dread(table.get(), type.get(), memory.get(), space.get(), H5P_DEFAULT, counts.data()),
+            file, "cannot read records/overlaps");
+    }
+    for (std::size_t k = 0; k < counts.size(); ++k) a.overlaps.counts()[k % kBins] += counts[k];
+    a.overlaps_at_records = true;
+  }
   if (s.records > 0) {
     std::vector<double> times;
     std::vector<std::uint64_t> counts;
@@ -971,6 +1086,51 @@ OutputSummary read_summary(const std::filesystem::path& path) {
     s.bodies_last = counts[s.records - 1];
   }
   return s;
+}
+
+void RunAccuracy::add(const timestep::StepReport& report) {
+  ++steps;
+  converged += report.converged ? 1 : 0;
+  const auto n = static_cast<std::uint64_t>(std::max(report.iterations, 0));
+  sweeps += n;
+  max_sweeps = std::max(max_sweeps, n);
+  max_residual = std::max(max_residual, report.residual);
+  contacts += report.contacts;
+  overlap_sum += report.mean_penetration * static_cast<double>(report.contacts);
+  max_overlap = std::max(max_overlap, report.max_penetration);
+  overlaps.add(report.overlaps);
+}
+
+double RunAccuracy::mean_overlap() const {
+  return contacts > 0 ? overlap_sum / static_cast<double>(contacts) : 0.0;
+}
+
+std::string RunAccuracy::describe() const {
+  const auto number = [](double x) {
+    char text[32];
+    std::snprintf(text, sizeof text, "%.3g", x);
+    return std::string(text);
+  };
+  std::string s = "solver: " + std::to_string(converged) + " of " + std::to_string(steps) +
+                  " steps converged (" +
+                  number(steps > 0 ? 100.0 * static_cast<double>(converged) /
+                                         static_cast<double>(steps)
+                                   : 100.0) +
+                  " %), sweeps a step: mean " +
+                  number(steps > 0 ? static_cast<double>(sweeps) / static_cast<double>(steps) : 0.0) +
+                  ", largest " + std::to_string(max_sweeps) + "; largest residual at exit " +
+                  number(max_residual) + "\n";
+  const auto both = [&](double x) {
+    return number(x) + " m" + (unit > 0.0 ? " (" + number(x / unit) + " r)" : std::string());
+  };
+  s += "overlaps: mean " + both(mean_overlap());
+  if (overlaps.count() > 0 && unit > 0.0) {
+    s += ", 99th percentile " + both(p99_overlap()) +
+         (overlaps_at_records ? " (at the records)" : "");
+  }
+  s += ", largest " + both(max_overlap);
+  if (unit > 0.0) s += "; r = " + number(unit) + " m, the smallest radius";
+  return s + "\n";
 }
 
 std::vector<StepInfo> read_steps(const std::filesystem::path& path) {

@@ -235,6 +235,7 @@ RunResult run(const scene::Scene& scene, const RunOptions& options, const Commun
     if (make_distribution) distribution = make_distribution();
   });
   RunResult result;
+  result.accuracy.unit = scene.settings.tolerance_radius;
   std::unique_ptr<scene::Simulation> simulation;
   std::unique_ptr<OutputFile> output;
   if (options.restart) {
@@ -362,6 +363,7 @@ RunResult run(const scene::Scene& scene, const RunOptions& options, const Commun
     std::uint64_t bodies[1] = {sim.system().owned_count()};
     comm.sum(bodies);
     output->add_step(report, bodies[0]);
+    result.accuracy.add(report);
     recorded = false;
     const std::uint64_t step = sim.stepper().steps();
     if (every > 0 && step % every == 0) {

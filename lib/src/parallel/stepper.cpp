@@ -271,7 +271,13 @@ void ParallelStepper::reduce(timestep::StepReport& report) const {
                            static_cast<double>(report.warm_started), report.kinetic_energy,
                            report.potential_energy,
                            report.mean_penetration * static_cast<double>(report.contacts)};
+  // The overlaps' histogram: counts, exact in doubles below 2⁵³.
+  const auto counts = report.overlaps.counts();
+  sums.insert(sums.end(), counts.begin(), counts.end());
   comm_.sum(sums);
+  for (std::size_t b = 0; b < counts.size(); ++b) {
+    report.overlaps.counts()[b] = static_cast<std::uint64_t>(sums[5 + b]);
+  }
   std::vector<double> maxima{static_cast<double>(report.iterations), report.residual,
                              report.max_penetration, report.converged ? 0.0 : 1.0};
   comm_.max(maxima);

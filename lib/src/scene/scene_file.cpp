@@ -564,6 +564,8 @@ void read_solver(TableReader& t, Scene& scene) {
       t.choice("on_non_convergence", {"count", "warn", "stop"}, 0));
   s.contact_tolerance = t.real("contact_tolerance", s.contact_tolerance, kNonNegative);
   s.drift_correction = t.real("drift_correction", s.drift_correction, kUnit);
+  s.overlap_recovery = t.real("overlap_recovery", s.overlap_recovery, kUnit);
+  s.max_recovery_speed = t.real("max_recovery_speed", s.max_recovery_speed, kPositive);
   s.reorder_interval = static_cast<int>(t.integer("reorder_interval", 100, 0, 1000000000));
   s.orientation_update = static_cast<timestep::OrientationUpdate>(
       t.choice("orientation_update", {"exponential_map", "add_and_normalize"}, 0));

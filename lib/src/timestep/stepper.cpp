@@ -52,6 +52,14 @@ void require_settings(const StepSettings& s) {
     throw InvalidArgument(where + "expected drift_correction in [0, 1] (0: off), found " +
                           format_number(s.drift_correction));
   }
+  if (!(s.overlap_recovery >= 0.0 && s.overlap_recovery <= 1.0)) {
+    throw InvalidArgument(where + "expected overlap_recovery in [0, 1] (0: off), found " +
+                          format_number(s.overlap_recovery));
+  }
+  if (!(s.max_recovery_speed > 0.0)) {
+    throw InvalidArgument(where + "expected max_recovery_speed > 0 [m/s] (may be infinite), found " +
+                          format_number(s.max_recovery_speed));
+  }
   switch (s.on_non_convergence) {
     case NonConvergence::count:
     case NonConvergence::warn:
@@ -147,10 +155,11 @@ void MoreauStepper::check_layout() {
   materials_.require_pairs(body_materials, static_materials);
   // The length the tolerance scales is the settings', or fixed by the first bodies seen.
   if (settings_.tolerance_radius > 0.0) {
-    tolerance_ = settings_.contact_tolerance * settings_.tolerance_radius;
-  } else if (tolerance_ == 0.0 && n > 0) {
-    tolerance_ = settings_.contact_tolerance * smallest;
+    unit_ = settings_.tolerance_radius;
+  } else if (unit_ == 0.0 && n > 0) {
+    unit_ = smallest;
   }
+  tolerance_ = settings_.contact_tolerance * unit_;
   const auto body_name = [&](std::int64_t i) {
     return id_name(system_.ids()[static_cast<std::size_t>(i)]);
   };
@@ -199,6 +208,7 @@ StepReport MoreauStepper::step() {
   report.seconds = {seconds(t0, t1), seconds(t1, t2), seconds(t2, t3),
                     seconds(t3, t4), seconds(t4, t5), seconds(t0, t5)};
   if (hooks_.reduce_report) hooks_.reduce_report(report);
+  report.p99_penetration = report.overlaps.quantile(0.99) * unit_;
   return report;
 }
 // [step]
@@ -298,6 +308,7 @@ void MoreauStepper::assemble(StepReport& report) {
   const auto states = system_.states();
   const std::size_t m = contacts_.size();
   problem_.contacts.resize(m);
+  const double recovery = 2.0 * settings_.overlap_recovery / settings_.dt;  // v_R per metre
   for (std::size_t k = 0; k < m; ++k) {
     const DetectedContact& c = contacts_[k];
     contact::CompactContact& cc = problem_.contacts[k];
@@ -322,6 +333,14 @@ void MoreauStepper::assemble(StepReport& report) {
     // it would do positive work and the energy of a ball at rest would creep up.
     const double eps_N = gamma_S(0) > 0.0 ? 1.0 : law.eps_N;
     cc.xi_A = {eps_N * gamma_S(0), law.eps_T * gamma_S(1), law.eps_T * gamma_S(2)};
+    // [gap law]
+    // The gap-aware law: an overlapping contact leaves the step at least at the recovery speed
+    // v_R, or at its restituted speed where that is larger, γ_N,E ≥ max(−ε_N γ_N,S, v_R).
+    if (recovery > 0.0 && c.geometry.g_N < 0.0) {
+      const double v_R = std::min(recovery * -c.geometry.g_N, settings_.max_recovery_speed);
+      cc.xi_A(0) = std::min(cc.xi_A(0), -v_R);
+    }
+    // [gap law]
     if (!cc.xi_A.allFinite() || !cc.r_a.allFinite() || !cc.r_b.allFinite()) {
       throw Error("MoreauStepper: step " + std::to_string(report.step) + ": the contact of " +
                   id_name(keys_[k].a) + " and " + id_name(keys_[k].b) +
@@ -425,8 +444,10 @@ void MoreauStepper::finish(StepReport& report) {
   }
   double penetration = 0.0;
   for (const DetectedContact& c : contacts_) {
-    report.max_penetration = std::max(report.max_penetration, -c.geometry.g_N);
-    penetration += std::max(0.0, -c.geometry.g_N);
+    const double overlap = std::max(0.0, -c.geometry.g_N);
+    report.max_penetration = std::max(report.max_penetration, overlap);
+    penetration += overlap;
+    report.overlaps.add(overlap, unit_);
   }
   if (!contacts_.empty()) {
     report.mean_penetration = penetration / static_cast<double>(contacts_.size());

@@ -238,6 +238,35 @@ class Hdf5Cleanup {
   Hdf5Cleanup& operator=(const Hdf5Cleanup&) = delete;
 };
 
+/// How accurately the steps of a run were solved and how far its contacts overlap (chapter 6,
+/// "Accuracy of a step"): what `grbd run` prints at its end, `grbd info` reads back from an output
+/// and every study table carries beside its results.
+struct RunAccuracy {
+  std::uint64_t steps = 0;         ///< steps counted
+  std::uint64_t converged = 0;     ///< of which the solver met its tolerance
+  std::uint64_t sweeps = 0;        ///< solver iterations over the steps
+  std::uint64_t max_sweeps = 0;    ///< the most of one step
+  double max_residual = 0.0;       ///< the largest residual a step's solve stopped at
+  std::uint64_t contacts = 0;      ///< contacts over the steps
+  double overlap_sum = 0.0;        ///< Σ max(0, −g_N) over those contacts [m]
+  double max_overlap = 0.0;        ///< the largest [m]
+  /// The distribution of the overlaps: of every contact of every step (`grbd run`), or of the
+  /// records' last steps (read from an output's /records/overlaps)
+  timestep::OverlapHistogram overlaps;
+  bool overlaps_at_records = false;  ///< where `overlaps` comes from
+  double unit = 0.0;                 ///< the unit r of `overlaps`, the smallest radius [m]
+
+  /// Counts one step.
+  void add(const timestep::StepReport& report);
+  /// The mean overlap over the contacts [m] (0 without contacts).
+  double mean_overlap() const;
+  /// The 99th percentile of the overlaps [m] (the upper edge of its bin, ≤ 12 % above).
+  double p99_overlap() const { return overlaps.quantile(0.99) * unit; }
+  /// Two lines: the share of steps converged, sweeps (mean, largest) and the largest residual;
+  /// the overlaps' mean, 99th percentile and largest in metres and in units of r.
+  std::string describe() const;
+};
+
 /// What `grbd info` says about an output file.
 struct OutputSummary {
   std::string scene_file;                      ///< attribute scene_file
@@ -258,6 +287,7 @@ struct OutputSummary {
   std::uint64_t non_converged_iterations = 0;  ///< the iterations they stopped at: the cap
   double max_penetration = 0.0;                ///< over the steps [m]
   double seconds = 0.0;                        ///< wall time of the steps [s]
+  RunAccuracy accuracy;                        ///< of the steps and the records' overlaps
 };
 
 /// Reads the summary of an output file (IoError naming the file and dataset when it is not one).
@@ -274,6 +304,7 @@ struct StepInfo {
   double residual = 0.0;         ///< the solver's last residual
   double max_penetration = 0.0;  ///< max(0, −g_N) over the contacts at the midpoint [m]
   double mean_penetration = 0.0;  ///< its mean over the contacts [m] (0 without contacts)
+  double p99_penetration = 0.0;   ///< its 99th percentile (bin's upper edge) [m]
   double kinetic_energy = 0.0;   ///< of the bodies at the end of the step [J]
   double seconds = 0.0;          ///< wall time of the step [s]
 };

@@ -93,6 +93,8 @@ struct RunResult {
   double output_seconds = 0.0;    ///< of which writing records and checkpoints [s]
   /// Times a run on many processes re-cut the domain to even the load (chapter 8; 0 serially).
   std::uint64_t rebalances = 0;
+  /// The convergence of this run's steps and the distribution of every overlap they solved.
+  RunAccuracy accuracy;
 };
 
 /// Runs `scene` to its end_time (or until *stop) on one process: run() with the one-process

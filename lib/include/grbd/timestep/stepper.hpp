@@ -8,6 +8,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <functional>
+#include <limits>
 #include <span>
 #include <string>
 #include <string_view>
@@ -20,6 +21,7 @@
 #include "grbd/timestep/body_system.hpp"
 #include "grbd/timestep/contacts.hpp"
 #include "grbd/timestep/materials.hpp"
+#include "grbd/timestep/overlaps.hpp"
 
 namespace grbd::timestep {
 
@@ -72,6 +74,15 @@ struct StepSettings {
   /// contact with g_N(q_M) < 0 pushes its bodies apart by β|g_N| along the normal (positions
   /// only, velocities untouched), shared by inverse mass and divided among the contacts of a body.
   double drift_correction = 0.0;
+  /// The gap-aware normal law (chapter 6, \ref ch06_gap_law): the fraction β_g ∈ [0, 1] of a
+  /// midpoint overlap that the step removes through the contact's velocity (0: off, Moreau's law).
+  /// A contact with g_N(q_M) < 0 must leave the step separating at least at the recovery speed
+  /// v_R = min(β_g · 2|g_N(q_M)|/Δt, max_recovery_speed): γ_N,E ≥ max(−ε_N γ_N,S, v_R). With
+  /// β_g = 1 and no cap, a lone overlap is gone at the end of the step, q_E = q_M + Δt/2 u_E.
+  double overlap_recovery = 0.0;
+  /// The largest recovery speed v_R [m/s], > 0 (may be +∞): it bounds the kinetic energy the law
+  /// can give a contact, ½ m v_R², and the height a resting body hops, v_R²/(2|g|).
+  double max_recovery_speed = std::numeric_limits<double>::infinity();
 };
 
 /// Wall time of the stages of one step [s].
@@ -98,6 +109,12 @@ struct StepReport {
   double max_penetration = 0.0;   ///< max(0, −g_N) over the contacts at the midpoint [m]
   /// the mean of max(0, −g_N) over the contacts at the midpoint [m] (0 without contacts)
   double mean_penetration = 0.0;
+  /// The 99th percentile of max(0, −g_N) over the contacts at the midpoint [m], read from
+  /// `overlaps` (the upper edge of its bin: at most 12 % above the true percentile)
+  double p99_penetration = 0.0;
+  /// The distribution of max(0, −g_N) over the contacts at the midpoint, in units of
+  /// MoreauStepper::overlap_unit()
+  OverlapHistogram overlaps;
   StepTimes seconds;              ///< stage timings
 };
 
@@ -190,6 +207,9 @@ class MoreauStepper {
   const StepHooks& hooks() const { return hooks_; }
   /// The active-set tolerance contact_tolerance × tolerance_radius [m] (0 before any body).
   double active_set_tolerance() const { return tolerance_; }
+  /// The length r that StepReport::overlaps counts in [m]: tolerance_radius, or the smallest
+  /// bounding radius of the first bodies (0 before any body).
+  double overlap_unit() const { return unit_; }
 
   /// \name The last step
   /// Contacts (at the midpoint, canonical order), their keys and percussions, and the contact
@@ -232,6 +252,7 @@ class MoreauStepper {
   std::uint64_t non_converged_ = 0;
   std::uint64_t checked_layout_ = ~std::uint64_t{0};
   double tolerance_ = 0.0;  // contact_tolerance × tolerance_radius [m]
+  double unit_ = 0.0;       // tolerance_radius, or the smallest first radius [m]
 
   std::vector<body::Loads> loads_;
   std::vector<DetectedContact> contacts_;
