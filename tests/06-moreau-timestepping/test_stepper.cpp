@@ -12,6 +12,7 @@
 #include <numbers>
 #include <numeric>
 #include <random>
+#include <tuple>
 #include <vector>
 
 #include "grbd/core/error.hpp"
@@ -874,26 +875,37 @@ TEST(DriftCorrection, OffKeepsOverlapsOnRemovesThemGeometricallyWithoutVelocity)
 // The gap-aware normal law (chapter 6, "The gap-aware normal law"): γ_N,E ≥ max(−ε_N γ_N,S, v_R),
 // v_R = min(β_g 2|g_N(q_M)|/Δt, v_max) for a contact overlapping at the midpoint.
 
+// The closed-form cases of the gap-aware law: spheres of radius r overlapping by δ₀ = (N − ½)
+// v_max Δt, β_g = 1, on the floor.
+struct GapCase {
+  double r = 0.01;
+  double dt = 1e-3;
+  int N = 10;
+  double delta0 = 1e-4;
+  double v_max() const { return delta0 / ((N - 0.5) * dt); }
+  StepSettings settings() const {
+    StepSettings s = tight(dt);
+    s.overlap_recovery = 1.0;
+    s.max_recovery_speed = v_max();
+    return s;
+  }
+};
+
 // A sphere at rest δ₀ = (N − ½) v_max Δt into the floor, β_g = 1: while the uncapped recovery
 // exceeds the cap, each step leaves the contact opening at exactly v_max (gravity keeps the law
 // binding), so the midpoint overlap of step k is δ₀ − (k − 1) v_max Δt; step N ends with the
 // overlap gone, step N + 1 has no overlap, and from then on the energy above rest never exceeds
 // the bound ½ m v_max² (the hop of a body the law pushed out).
 TEST(GapLaw, ASphereInTheFloorRisesAtTheCapLeavesInThePredictedStepAndGainsAtMostHalfMVSquared) {
-  const double r = 0.01;
-  const double dt = 1e-3;
-  const int N = 10;
-  const double delta0 = 1e-4;
-  const double v_max = delta0 / ((N - 0.5) * dt);
+  const GapCase gap;
+  const auto [r, dt, N, delta0] = std::tuple{gap.r, gap.dt, gap.N, gap.delta0};
+  const double v_max = gap.v_max();
   BodySystem system;
   StaticGeometry statics;
   statics.add(demo::floor_object());
   system.add(sphere_body(1, r, Vector3(0.0, 0.0, r - delta0)));
   const MaterialTable materials = demo::one_material(0.5);
-  StepSettings settings = tight(dt);
-  settings.overlap_recovery = 1.0;
-  settings.max_recovery_speed = v_max;
-  MoreauStepper stepper(system, statics, materials, settings);
+  MoreauStepper stepper(system, statics, materials, gap.settings());
   const double m = system.inertia()[0].m;
   for (int k = 1; k <= N; ++k) {
     const StepReport report = stepper.step();
@@ -917,11 +929,10 @@ TEST(GapLaw, ASphereInTheFloorRisesAtTheCapLeavesInThePredictedStepAndGainsAtMos
 // A column of five spheres overlapping by δ₀ each: every contact binds at the cap, so every
 // overlap shrinks by v_max Δt a step, all at once, and all are gone after N steps.
 TEST(GapLaw, AColumnOfOverlapsOpensContactByContactAtTheCap) {
-  const double r = 0.01;
-  const double dt = 1e-3;
-  const int N = 10;
-  const double delta0 = 2e-4;
-  const double v_max = delta0 / ((N - 0.5) * dt);
+  GapCase gap;
+  gap.delta0 = 2e-4;
+  const auto [r, dt, N, delta0] = std::tuple{gap.r, gap.dt, gap.N, gap.delta0};
+  const double v_max = gap.v_max();
   BodySystem system;
   StaticGeometry statics;
   statics.add(demo::floor_object());
@@ -930,10 +941,7 @@ TEST(GapLaw, AColumnOfOverlapsOpensContactByContactAtTheCap) {
                            Vector3(0.0, 0.0, r - delta0 + (2.0 * r - delta0) * i)));
   }
   const MaterialTable materials = demo::one_material(0.5);
-  StepSettings settings = tight(dt);
-  settings.overlap_recovery = 1.0;
-  settings.max_recovery_speed = v_max;
-  MoreauStepper stepper(system, statics, materials, settings);
+  MoreauStepper stepper(system, statics, materials, gap.settings());
   for (int k = 1; k <= N; ++k) {
     const StepReport report = stepper.step();
     ASSERT_EQ(report.contacts, 5u) << "step " << k;
