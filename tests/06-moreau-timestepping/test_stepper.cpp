@@ -692,6 +692,9 @@ TEST(Stepper, RefusesBadSettingsMissingMaterialPairsAndUnsupportedShapePairs) {
   bad.max_recovery_speed = std::nan("");
   EXPECT_THROW(MoreauStepper(system, statics, materials, bad), InvalidArgument);
   bad = {};
+  bad.look_ahead = -1.0;
+  EXPECT_THROW(MoreauStepper(system, statics, materials, bad), InvalidArgument);
+  bad = {};
   bad.skin = -1e-3;
   EXPECT_THROW(MoreauStepper(system, statics, materials, bad), InvalidArgument);
   materials.set_pair(1, 1, {0.5, 0.0, 0.0});
@@ -967,6 +970,42 @@ TEST(GapLaw, WithBetaAtMostHalfEpsilonTheBouncingBallsImpactsAreUnchanged) {
   ASSERT_GE(off.impacts.size(), 8u);
   EXPECT_EQ(on.impacts, off.impacts);
   EXPECT_FALSE(on.energy_increased) << "relative gain " << on.worst_gain;
+}
+
+// The look-ahead (The gap-aware normal law): a ball falling onto the floor at v with a look-ahead
+// longer than v Δt is stopped by the step whose midpoint sees it still apart, so that the next
+// midpoint finds it touching: with ε_N = 0 it never overlaps (to round-off), where Moreau's
+// active set lets it in by up to v Δt; the energy never rises.
+TEST(GapLaw, WithALookAheadAFallingBallLandsWithoutOverlap) {
+  const auto land = [](double look_ahead) {
+    BodySystem system;
+    const double r = 0.1;
+    system.add(sphere_body(1, r, Vector3(0.0, 0.0, r + 0.1)));
+    StaticGeometry statics;
+    statics.add(demo::floor_object());
+    const MaterialTable materials = demo::one_material(0.3, 0.0);
+    StepSettings settings = tight(1e-3);
+    settings.look_ahead = look_ahead;
+    MoreauStepper stepper(system, statics, materials, settings);
+    double overlap = 0.0;
+    double energy = std::numeric_limits<double>::infinity();
+    bool rose = false;
+    for (int k = 0; k < 400; ++k) {
+      const StepReport report = stepper.step();
+      overlap = std::max(overlap, report.max_penetration);
+      const double e = report.kinetic_energy + report.potential_energy;
+      rose = rose || e > energy + 1e-12 * std::abs(energy);
+      energy = e;
+    }
+    return std::tuple{overlap, rose, system.states()[0].u.norm()};
+  };
+  const auto [moreau, moreau_rose, moreau_speed] = land(0.0);
+  EXPECT_GT(moreau, 1e-4) << "Moreau's active set admits the ball overlapping";
+  const auto [ahead, ahead_rose, ahead_speed] = land(0.02);  // 2 mm > v Δt = 1.4 mm
+  EXPECT_LT(ahead, 1e-14) << "the look-ahead stops it touching";
+  EXPECT_FALSE(ahead_rose);
+  EXPECT_FALSE(moreau_rose);
+  EXPECT_LT(ahead_speed, 1e-12) << "at rest";
 }
 
 // The overlaps' histogram (Accuracy of a step): bins of 10^(1/20) from 1e-8 r to r, quantiles

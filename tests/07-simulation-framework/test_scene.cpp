@@ -192,8 +192,10 @@ TEST(SceneFile, OutOfRangeValuesNameTheKeyTheRangeAndTheValue) {
 TEST(SceneFile, TheGapAwareLawIsASceneKey) {
   const Scene scene = parse_scene(
       replace(kMinimal, "[simulation]",
-              "[solver]\noverlap_recovery = 0.5\nmax_recovery_speed = 0.02\n[simulation]"),
+              "[solver]\noverlap_recovery = 0.5\nmax_recovery_speed = 0.02\nlook_ahead = 0.1\n"
+              "[simulation]"),
       "scene.toml");
+  EXPECT_EQ(scene.settings.look_ahead, 0.1);
   EXPECT_EQ(scene.settings.overlap_recovery, 0.5);
   EXPECT_EQ(scene.settings.max_recovery_speed, 0.02);
   EXPECT_EQ(error_of(replace(kMinimal, "[simulation]", "[solver]\noverlap_recovery = 1.5\n[simulation]")),

@@ -566,6 +566,7 @@ void read_solver(TableReader& t, Scene& scene) {
   s.drift_correction = t.real("drift_correction", s.drift_correction, kUnit);
   s.overlap_recovery = t.real("overlap_recovery", s.overlap_recovery, kUnit);
   s.max_recovery_speed = t.real("max_recovery_speed", s.max_recovery_speed, kPositive);
+  s.look_ahead = t.real("look_ahead", s.look_ahead, kNonNegative);
   s.reorder_interval = static_cast<int>(t.integer("reorder_interval", 100, 0, 1000000000));
   s.orientation_update = static_cast<timestep::OrientationUpdate>(
       t.choice("orientation_update", {"exponential_map", "add_and_normalize"}, 0));

@@ -56,6 +56,10 @@ void require_settings(const StepSettings& s) {
     throw InvalidArgument(where + "expected overlap_recovery in [0, 1] (0: off), found " +
                           format_number(s.overlap_recovery));
   }
+  if (!(s.look_ahead >= 0.0) || !std::isfinite(s.look_ahead)) {
+    throw InvalidArgument(where + "expected a finite look_ahead >= 0 (0: off), found " +
+                          format_number(s.look_ahead));
+  }
   if (!(s.max_recovery_speed > 0.0)) {
     throw InvalidArgument(where + "expected max_recovery_speed > 0 [m/s] (may be infinite), found " +
                           format_number(s.max_recovery_speed));
@@ -159,7 +163,7 @@ void MoreauStepper::check_layout() {
   } else if (unit_ == 0.0 && n > 0) {
     unit_ = smallest;
   }
-  tolerance_ = settings_.contact_tolerance * unit_;
+  tolerance_ = std::max(settings_.contact_tolerance, settings_.look_ahead) * unit_;
   const auto body_name = [&](std::int64_t i) {
     return id_name(system_.ids()[static_cast<std::size_t>(i)]);
   };
@@ -339,6 +343,11 @@ void MoreauStepper::assemble(StepReport& report) {
     if (recovery > 0.0 && c.geometry.g_N < 0.0) {
       const double v_R = std::min(recovery * -c.geometry.g_N, settings_.max_recovery_speed);
       cc.xi_A(0) = std::min(cc.xi_A(0), -v_R);
+    }
+    // The look-ahead: a contact still apart at the midpoint may close its gap by the next
+    // midpoint, γ_N,E ≥ −g_N(q_M)/Δt, and is not restituted (it has not hit).
+    if (settings_.look_ahead > 0.0 && c.geometry.g_N > 0.0) {
+      cc.xi_A(0) = c.geometry.g_N / settings_.dt;
     }
     // [gap law]
     if (!cc.xi_A.allFinite() || !cc.r_a.allFinite() || !cc.r_b.allFinite()) {

@@ -3,6 +3,7 @@
 /// \brief The domain split among processes (chapter 8): a Cartesian grid of subdomains, the owner
 /// of a position, and whether a body reaches into a subdomain.
 
+#include <algorithm>
 #include <array>
 #include <memory>
 #include <vector>
@@ -95,7 +96,8 @@ inline timestep::GlobalId solving_side(const timestep::ContactKey& key) {
 /// half the skin: every body a process's bodies can touch before the next rebuild lies within its
 /// bounding radius, the largest one and this margin (BodyExchange, ParallelStepper).
 inline double ghost_margin(const timestep::StepSettings& settings) {
-  return settings.contact_tolerance * settings.tolerance_radius + settings.skin;
+  return std::max(settings.contact_tolerance, settings.look_ahead) * settings.tolerance_radius +
+         settings.skin;
 }
 
 /// The reach of a contact between two bodies of bounding radius at most `max_radius` [m]: two

@@ -83,6 +83,13 @@ struct StepSettings {
   /// The largest recovery speed v_R [m/s], > 0 (may be +∞): it bounds the kinetic energy the law
   /// can give a contact, ½ m v_R², and the height a resting body hops, v_R²/(2|g|).
   double max_recovery_speed = std::numeric_limits<double>::infinity();
+  /// The look-ahead of the gap-aware law (chapter 6, \ref ch06_gap_law), a length in units of
+  /// tolerance_radius, ≥ 0 and finite (0: off): contacts whose gap at the midpoint is at most
+  /// look_ahead × tolerance_radius are active, and one with a positive gap g_N(q_M) may approach
+  /// by that gap until the next step's midpoint and no further, γ_N,E ≥ −g_N(q_M)/Δt (Stewart and
+  /// Trinkle 1996), without restitution: an impact then starts at the next midpoint with the
+  /// bodies touching instead of overlapping by up to |γ_N| Δt.
+  double look_ahead = 0.0;
 };
 
 /// Wall time of the stages of one step [s].
