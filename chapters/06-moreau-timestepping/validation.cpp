@@ -682,9 +682,12 @@ void gap_law_pile() {
     const char* name;
     double beta;
     double v_max;
+    double look_ahead;  // in units of r
   };
   double potential_off = 0.0;
-  for (const Law law : {Law{"off", 0.0, 1.0}, Law{"b1v001", 1.0, 0.01}, Law{"b02v005", 0.2, 0.05}}) {
+  for (const Law law : {Law{"off", 0.0, 1.0, 0.0}, Law{"b1v001", 1.0, 0.01, 0.0},
+                        Law{"b02v005", 0.2, 0.05, 0.0}, Law{"ahead", 0.0, 1.0, 0.1},
+                        Law{"ahead_b02v005", 0.2, 0.05, 0.1}}) {
     PileState state = pile_state(n, r);
     const PileRun run = settle(state, PileSolver::sor_warm, dt, t_end, nullptr, 0,
                                [&](StepSettings& s) {
@@ -692,6 +695,7 @@ void gap_law_pile() {
                                  s.solver.max_iterations = 100;
                                  s.overlap_recovery = law.beta;
                                  s.max_recovery_speed = law.v_max;
+                                 s.look_ahead = law.look_ahead;
                                });
     const std::size_t steps = run.reports.size();
     OverlapHistogram late;
@@ -713,17 +717,26 @@ void gap_law_pile() {
     if (law.beta == 0.0) potential_off = last.potential_energy;
     const std::string key = "gap." + std::string(law.name) + ".";
     const double mean = sum / static_cast<double>(std::max<std::size_t>(contacts, 1));
-    value((key + "largest").c_str(), "%.1f", 1e6 * largest);
-    value((key + "p99").c_str(), "%.1f", 1e6 * late.quantile(0.99) * r);
-    value((key + "mean").c_str(), "%.2f", 1e6 * mean);
+    // Micrometres as TeX: two digits, powers of ten below 0.01 µm.
+    const auto um = [](double metres) {
+      const double x = 1e6 * metres;
+      if (x <= 0.0) return std::string("0");
+      if (x < 0.01) return tex_power(x);
+      char text[32];
+      std::snprintf(text, sizeof text, "%.2g", x);
+      return std::string(text);
+    };
+    value((key + "largest").c_str(), "%s", um(largest).c_str());
+    value((key + "p99").c_str(), "%s", um(late.quantile(0.99) * r).c_str());
+    value((key + "mean").c_str(), "%s", um(mean).c_str());
     value((key + "converged").c_str(), "%.0f", 100.0 * converged / late_steps);
     value((key + "kinetic").c_str(), "%s", tex_power(last.kinetic_energy).c_str());
     value((key + "cpu").c_str(), "%.1f", run.seconds);
-    say("gap-aware law on the pile, %s (beta_g %.1f, v_max %.2f m/s), SOR tol 1e-4, at most 100 "
-        "sweeps, last quarter: largest overlap %.1f um, 99th percentile %.1f um, mean %.2f um; "
+    say("gap-aware law on the pile, %s (beta_g %.1f, v_max %.2f m/s, look-ahead %.1f r), SOR tol 1e-4, at most 100 "
+        "sweeps, last quarter: largest overlap %.2g um, 99th percentile %.2g um, mean %.2g um; "
         "%d of %d steps converged; E_kin at the end %.1e J, potential energy %+.2e J against the "
         "law off; %.1f s\n",
-        law.name, law.beta, law.v_max, 1e6 * largest, 1e6 * late.quantile(0.99) * r, 1e6 * mean,
+        law.name, law.beta, law.v_max, law.look_ahead, 1e6 * largest, 1e6 * late.quantile(0.99) * r, 1e6 * mean,
         converged, late_steps, last.kinetic_energy, last.potential_energy - potential_off,
         run.seconds);
   }
