@@ -57,6 +57,9 @@ struct Flow {
   double seconds = 0.0;
   double penetration = 0.0;  // the largest over the steps of the second half [m]
   double sweeps = 0.0;       // the solver's mean over the steps of the second half
+  double converged = 0.0;    // the share of the second half's steps that met the tolerance [%]
+  double mean_overlap = 0.0;  // the mean overlap over the second half's contacts [m]
+  double p99_overlap = 0.0;   // the median over the second half's steps of their 99th percentile [m]
   bool stopped = false;      // the layer came to rest: no steady flow at this angle and depth
 };
 
@@ -235,9 +238,23 @@ void measure_all(const std::filesystem::path& dir, const grbd::scene::Scene& bas
       }
     }
     const double change = incline::energy_change(steps);
+    // The accuracy of the second half (chapter 6, "Accuracy of a step").
+    const std::size_t half = steps.size() - steps.size() / 2;
+    std::vector<double> p99;
+    double overlap_sum = 0.0, contacts = 0.0;
     for (std::size_t k = steps.size() / 2; k < steps.size(); ++k) {
       flow.penetration = std::max(flow.penetration, steps[k].max_penetration);
-      flow.sweeps += steps[k].iterations / static_cast<double>(steps.size() - steps.size() / 2);
+      flow.sweeps += steps[k].iterations / static_cast<double>(half);
+      flow.converged += (steps[k].converged ? 100.0 : 0.0) / static_cast<double>(half);
+      overlap_sum += steps[k].mean_penetration * static_cast<double>(steps[k].contacts);
+      contacts += static_cast<double>(steps[k].contacts);
+      p99.push_back(steps[k].p99_penetration);
+    }
+    flow.mean_overlap = contacts > 0.0 ? overlap_sum / contacts : 0.0;
+    if (!p99.empty()) {
+      std::nth_element(p99.begin(), p99.begin() + static_cast<std::ptrdiff_t>(p99.size() / 2),
+                       p99.end());
+      flow.p99_overlap = p99[p99.size() / 2];
     }
     if (flow.stopped) {
       std::printf("%s: theta = %g deg: the layer of %.1f grains came to rest\n", kProgram, angle,
@@ -299,6 +316,9 @@ void measure_all(const std::filesystem::path& dir, const grbd::scene::Scene& bas
     values.set(k + "minutes", "%.1f", flow.seconds / 60.0);
     values.set(k + "penetration_mm", "%.2f", flow.penetration * 1e3);
     values.set(k + "sweeps", "%.0f", flow.sweeps);
+    values.set(k + "converged", "%.0f", flow.converged);
+    values.set(k + "mean_overlap_um", "%.1f", flow.mean_overlap * 1e6);
+    values.set(k + "p99_overlap_um", "%.0f", flow.p99_overlap * 1e6);
   }
   study.finish();
   std::string rest;
