@@ -239,23 +239,19 @@ void measure_all(const std::filesystem::path& dir, const grbd::scene::Scene& bas
     }
     const double change = incline::energy_change(steps);
     // The accuracy of the second half (chapter 6, "Accuracy of a step").
-    const std::size_t half = steps.size() - steps.size() / 2;
+    grbd::io::RunAccuracy late;
     std::vector<double> p99;
-    double overlap_sum = 0.0, contacts = 0.0;
     for (std::size_t k = steps.size() / 2; k < steps.size(); ++k) {
-      flow.penetration = std::max(flow.penetration, steps[k].max_penetration);
-      flow.sweeps += steps[k].iterations / static_cast<double>(half);
-      flow.converged += (steps[k].converged ? 100.0 : 0.0) / static_cast<double>(half);
-      overlap_sum += steps[k].mean_penetration * static_cast<double>(steps[k].contacts);
-      contacts += static_cast<double>(steps[k].contacts);
+      late.add(steps[k]);
       p99.push_back(steps[k].p99_penetration);
     }
-    flow.mean_overlap = contacts > 0.0 ? overlap_sum / contacts : 0.0;
-    if (!p99.empty()) {
-      std::nth_element(p99.begin(), p99.begin() + static_cast<std::ptrdiff_t>(p99.size() / 2),
-                       p99.end());
-      flow.p99_overlap = p99[p99.size() / 2];
-    }
+    flow.penetration = late.max_overlap;
+    flow.sweeps = static_cast<double>(late.sweeps) / static_cast<double>(late.steps);
+    flow.converged = 100.0 * static_cast<double>(late.converged) / static_cast<double>(late.steps);
+    flow.mean_overlap = late.mean_overlap();
+    std::nth_element(p99.begin(), p99.begin() + static_cast<std::ptrdiff_t>(p99.size() / 2),
+                     p99.end());
+    flow.p99_overlap = p99[p99.size() / 2];
     if (flow.stopped) {
       std::printf("%s: theta = %g deg: the layer of %.1f grains came to rest\n", kProgram, angle,
                   flow.depth / 0.002);

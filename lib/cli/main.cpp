@@ -377,13 +377,11 @@ int info_command(const std::string& file) {
     }
     std::cout << "\n  steps: " << s.steps << ", wall time " << s.seconds << " s\n"
               << "  contacts: at most " << s.max_contacts << "\n";
-    if (s.non_converged > 0) {
-      std::cout << "  " << s.non_converged << " steps stopped at the cap of "
-                << s.non_converged_iterations
+    if (const std::uint64_t capped = s.accuracy.steps - s.accuracy.converged; capped > 0) {
+      std::cout << "  " << capped << " steps stopped at the cap of " << s.non_converged_iterations
                 << " iterations ([solver] max_iterations) before the tolerance\n";
     }
-    std::cout
-              << indented(s.accuracy.describe());
+    std::cout << indented(s.accuracy.describe());
     return 0;
   } catch (const grbd::Error& e) {
     std::cerr << "grbd info: " << e.what() << '\n';

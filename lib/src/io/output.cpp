@@ -209,7 +209,8 @@ std::size_t first_different_line(std::string_view a, std::string_view b) {
 }
 
 Handle overlap_row_type();
-void read_row(hid_t table, hid_t type, std::uint64_t index, void* out, const std::string& file);
+void read_rows(hid_t table, hid_t type, std::uint64_t first, std::uint64_t n, void* out,
+               const std::string& file);
 void describe_overlaps(hid_t table, double unit, const std::string& file);
 
 struct OutputFile::Impl {
@@ -266,16 +267,18 @@ Handle overlap_row_type() {
   return Handle(H5Tarray_create2(H5T_STD_U64LE, 1, &bins), H5Tclose);
 }
 
-// Reads row `index` of the 1-D dataset `table` as `type` into `out`.
-void read_row(hid_t table, hid_t type, std::uint64_t index, void* out, const std::string& file) {
+// Reads rows [first, first + n) of the 1-D dataset `table` as `type` into `out`.
+void read_rows(hid_t table, hid_t type, std::uint64_t first, std::uint64_t n, void* out,
+               const std::string& file) {
+  if (n == 0) return;
   Handle space = check(H5Dget_space(table), H5Sclose, file, "cannot read a dataset's shape");
-  const hsize_t first = index, one = 1;
-  check(H5Sselect_hyperslab(space.get(), H5S_SELECT_SET, &first, nullptr, &one, nullptr), file,
-        "cannot select a row");
-  Handle memory = check(H5Screate_simple(1, &one, nullptr), H5Sclose, file,
+  const hsize_t start = first, count = n;
+  check(H5Sselect_hyperslab(space.get(), H5S_SELECT_SET, &start, nullptr, &count, nullptr), file,
+        "cannot select rows");
+  Handle memory = check(H5Screate_simple(1, &count, nullptr), H5Sclose, file,
                         "cannot create a dataspace");
   check(H5Dread(table, type, memory.get(), space.get(), H5P_DEFAULT, out), file,
-        "cannot read a row");
+        "cannot read rows");
 }
 
 // What a reader needs to turn the counts into overlaps: the unit r and the bins' edges.
@@ -483,11 +486,11 @@ void OutputFile::reopen(const scene::Scene& scene, const OutputPosition& at,
       std::uint64_t record_step = 0;
       h5::StepRow last{};
       Handle step_type = h5::step_row_type();
-      read_row(o.record_step.get(), H5T_NATIVE_UINT64, at.records, &record_step, o.file);
-      read_row(o.steps.get(), step_type.get(), at.steps - 1, &last, o.file);
+      read_rows(o.record_step.get(), H5T_NATIVE_UINT64, at.records, 1, &record_step, o.file);
+      read_rows(o.steps.get(), step_type.get(), at.steps - 1, 1, &last, o.file);
       if (record_step == last.step) {
-        read_row(o.record_overlaps.get(), o.overlaps_type.get(), at.records,
-                 o.last_overlaps.counts().data(), o.file);
+        read_rows(o.record_overlaps.get(), o.overlaps_type.get(), at.records, 1,
+                  o.last_overlaps.counts().data(), o.file);
       }
     }
     h5::resize(o.record_overlaps.get(), at.records, o.file, "records/overlaps");
@@ -1024,31 +1027,15 @@ OutputSummary read_summary(const std::filesystem::path& path) {
   }
   const std::vector<StepInfo> steps = step_infos(root, file);
   s.steps = steps.size();
-  double iterations = 0.0;
+  RunAccuracy& a = s.accuracy;
   for (const StepInfo& row : steps) {
+    a.add(row);
     s.max_contacts = std::max<std::uint64_t>(s.max_contacts, row.contacts);
-    s.max_iterations = std::max<std::uint64_t>(
-        s.max_iterations, static_cast<std::uint64_t>(std::max(row.iterations, 0)));
-    iterations += row.iterations;
-    s.non_converged += row.converged ? 0 : 1;
     if (!row.converged) {
       s.non_converged_iterations = std::max<std::uint64_t>(
           s.non_converged_iterations, static_cast<std::uint64_t>(std::max(row.iterations, 0)));
     }
-    s.max_penetration = std::max(s.max_penetration, row.max_penetration);
     s.seconds += row.seconds;
-  }
-  if (!steps.empty()) s.mean_iterations = iterations / static_cast<double>(steps.size());
-  RunAccuracy& a = s.accuracy;
-  for (const StepInfo& row : steps) {
-    ++a.steps;
-    a.converged += row.converged ? 1 : 0;
-    a.sweeps += static_cast<std::uint64_t>(std::max(row.iterations, 0));
-    a.max_sweeps = std::max<std::uint64_t>(a.max_sweeps, static_cast<std::uint64_t>(std::max(row.iterations, 0)));
-    a.max_residual = std::max(a.max_residual, row.residual);
-    a.contacts += row.contacts;
-    a.overlap_sum += row.mean_penetration * static_cast<double>(row.contacts);
-    a.max_overlap = std::max(a.max_overlap, row.max_penetration);
   }
   if (H5Lexists(records.get(), "overlaps", H5P_DEFAULT) > 0) {
     Handle table = open_dataset(records.get(), "overlaps", file);
@@ -1059,17 +1046,8 @@ OutputSummary read_summary(const std::filesystem::path& path) {
       h5::fail(file, "records/overlaps holds fewer rows than records@count");
     }
     std::vector<std::uint64_t> counts(n * kBins);
-    if (n > 0) {
-      Handle type = overlap_row_type();
-      Handle space = check(H5Dget_space(table.get()), H5Sclose, file, "cannot read records/overlaps");
-      const hsize_t first = 0;
-      check(H5Sselect_hyperslab(space.get(), H5S_SELECT_SET, &first, nullptr, &n, nullptr), file,
-            "cannot select records/overlaps");
-      Handle memory = check(H5Screate_simple(1, &n, nullptr), H5Sclose, file,
-                            "cannot create a dataspace");
-      check(H5Dread(table.get(), type.get(), memory.get(), space.get(), H5P_DEFAULT, counts.data()),
-            file, "cannot read records/overlaps");
-    }
+    Handle type = overlap_row_type();
+    read_rows(table.get(), type.get(), 0, n, counts.data(), file);
     for (std::size_t k = 0; k < counts.size(); ++k) a.overlaps.counts()[k % kBins] += counts[k];
     a.overlaps_at_records = true;
   }
@@ -1088,17 +1066,28 @@ OutputSummary read_summary(const std::filesystem::path& path) {
   return s;
 }
 
-void RunAccuracy::add(const timestep::StepReport& report) {
+void RunAccuracy::count(bool step_converged, int iterations, double residual,
+                        std::uint64_t step_contacts, double mean, double largest) {
   ++steps;
-  converged += report.converged ? 1 : 0;
-  const auto n = static_cast<std::uint64_t>(std::max(report.iterations, 0));
+  converged += step_converged ? 1 : 0;
+  const auto n = static_cast<std::uint64_t>(std::max(iterations, 0));
   sweeps += n;
   max_sweeps = std::max(max_sweeps, n);
-  max_residual = std::max(max_residual, report.residual);
-  contacts += report.contacts;
-  overlap_sum += report.mean_penetration * static_cast<double>(report.contacts);
-  max_overlap = std::max(max_overlap, report.max_penetration);
+  max_residual = std::max(max_residual, residual);
+  contacts += step_contacts;
+  overlap_sum += mean * static_cast<double>(step_contacts);
+  max_overlap = std::max(max_overlap, largest);
+}
+
+void RunAccuracy::add(const timestep::StepReport& report) {
+  count(report.converged, report.iterations, report.residual, report.contacts,
+        report.mean_penetration, report.max_penetration);
   overlaps.add(report.overlaps);
+}
+
+void RunAccuracy::add(const StepInfo& step) {
+  count(step.converged, step.iterations, step.residual, step.contacts, step.mean_penetration,
+        step.max_penetration);
 }
 
 double RunAccuracy::mean_overlap() const {

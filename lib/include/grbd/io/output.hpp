@@ -238,6 +238,8 @@ class Hdf5Cleanup {
   Hdf5Cleanup& operator=(const Hdf5Cleanup&) = delete;
 };
 
+struct StepInfo;
+
 /// How accurately the steps of a run were solved and how far its contacts overlap (chapter 6,
 /// "Accuracy of a step"): what `grbd run` prints at its end, `grbd info` reads back from an output
 /// and every study table carries beside its results.
@@ -256,8 +258,10 @@ struct RunAccuracy {
   bool overlaps_at_records = false;  ///< where `overlaps` comes from
   double unit = 0.0;                 ///< the unit r of `overlaps`, the smallest radius [m]
 
-  /// Counts one step.
+  /// Counts one step, its overlaps' distribution too.
   void add(const timestep::StepReport& report);
+  /// Counts one row of an output's /steps (which keeps no distribution).
+  void add(const StepInfo& step);
   /// The mean overlap over the contacts [m] (0 without contacts).
   double mean_overlap() const;
   /// The 99th percentile of the overlaps [m] (the upper edge of its bin, ≤ 12 % above).
@@ -265,6 +269,10 @@ struct RunAccuracy {
   /// Two lines: the share of steps converged, sweeps (mean, largest) and the largest residual;
   /// the overlaps' mean, 99th percentile and largest in metres and in units of r.
   std::string describe() const;
+
+ private:
+  void count(bool step_converged, int iterations, double residual, std::uint64_t step_contacts,
+             double mean, double largest);
 };
 
 /// What `grbd info` says about an output file.
@@ -281,13 +289,11 @@ struct OutputSummary {
   double t_last = 0.0;                         ///< time of the last record [s]
   std::uint64_t bodies_last = 0;               ///< bodies in the last record
   std::uint64_t max_contacts = 0;              ///< over the steps
-  double mean_iterations = 0.0;                ///< over the steps
-  std::uint64_t max_iterations = 0;            ///< over the steps
-  std::uint64_t non_converged = 0;             ///< steps that did not converge
-  std::uint64_t non_converged_iterations = 0;  ///< the iterations they stopped at: the cap
-  double max_penetration = 0.0;                ///< over the steps [m]
+  /// The iterations the steps that did not converge stopped at: the cap (0 if all converged)
+  std::uint64_t non_converged_iterations = 0;
   double seconds = 0.0;                        ///< wall time of the steps [s]
-  RunAccuracy accuracy;                        ///< of the steps and the records' overlaps
+  /// Convergence, sweeps and overlaps of the steps; the overlaps' distribution of the records
+  RunAccuracy accuracy;
 };
 
 /// Reads the summary of an output file (IoError naming the file and dataset when it is not one).

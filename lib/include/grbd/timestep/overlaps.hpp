@@ -26,8 +26,6 @@ class OverlapHistogram {
   void add(double overlap, double r) { ++counts_[bin(overlap / r)]; }
   /// Adds the counts of another histogram (steps of a run, processes of a step).
   void add(const OverlapHistogram& other);
-  /// Forgets every count.
-  void clear() { counts_.fill(0); }
   /// The number of overlaps counted.
   std::uint64_t count() const;
   /// The upper edge, in units of r, of the bin that holds the p-quantile (p ∈ [0, 1]) of the
