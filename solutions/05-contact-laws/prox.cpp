@@ -223,13 +223,14 @@ template <bool Isotropic>
 [[gnu::flatten]] SweepReport compact_sweep(const CompactProblem& problem,
                                            std::span<const RFactors> r, ProxForm form,
                                            std::span<Vector6> u, std::span<Vector3> lambda,
-                                           double abs_tol, double rel_tol) {
+                                           double abs_tol, double rel_tol, bool residual) {
   const std::size_t n = problem.contacts.size();
   const CompactContact* contacts = problem.contacts.data();
   const WorldInverseMass* M_inv = problem.M_inv.data();
   Vector6* U = u.data();
   double probe = 0.0;     // 0 · λ summed: stays 0 while every λ is finite
   bool unsettled = false;  // some |Δλ_k| > abs_tol + rel_tol |λ_k| (or NaN)
+  double F2 = 0.0;         // Σ ‖F_i‖², each at the λ_i and ξ_i the sweep found
   for (std::size_t i = 0; i < n; ++i) {
     prefetch_ahead(contacts, i, n, 16, U, M_inv);  // 136-byte records: 16 ahead
     const CompactContact& c = contacts[i];
@@ -242,6 +243,7 @@ template <bool Isotropic>
                      c.t1(0) * w[0] + c.t1(1) * w[1] + c.t1(2) * w[2] + c.xi_A(1),
                      t2(0) * w[0] + t2(1) * w[1] + t2(2) * w[2] + c.xi_A(2));
     Vector3& l = lambda[i];
+    if (residual) F2 += natural_map(l, xi, c.mu).squaredNorm();
     const Vector3 updated = form == ProxForm::alart_curnier
                                 ? alart_curnier_update(l, xi, r[i].r_N, r[i].r_T, c.mu)
                                 : de_saxce_update(l, xi, std::min(r[i].r_N, r[i].r_T), c.mu);
@@ -261,7 +263,7 @@ template <bool Isotropic>
       apply_percussion<Isotropic>(-1.0, M_inv[c.body_b], c.r_b, P, U[c.body_b].data());
     }
   }
-  return {probe == 0.0, !unsettled};
+  return {probe == 0.0, !unsettled, residual ? std::sqrt(F2) : -1.0};
 }
 // [compact sweep kernel]
 
@@ -270,12 +272,12 @@ template <bool Isotropic>
 // [compact sweep]
 SweepReport sor_sweep(const CompactProblem& problem, std::span<const RFactors> r, ProxForm form,
                       std::span<Vector6> u, std::span<Vector3> lambda, double abs_tol,
-                      double rel_tol) {
+                      double rel_tol, bool residual) {
   require_sweep_sizes(problem.contacts.size(), problem.M_inv.size(), r.size(), lambda.size(),
                       u.size());
   return problem.isotropic
-             ? compact_sweep<true>(problem, r, form, u, lambda, abs_tol, rel_tol)
-             : compact_sweep<false>(problem, r, form, u, lambda, abs_tol, rel_tol);
+             ? compact_sweep<true>(problem, r, form, u, lambda, abs_tol, rel_tol, residual)
+             : compact_sweep<false>(problem, r, form, u, lambda, abs_tol, rel_tol, residual);
 }
 // [compact sweep]
 

@@ -260,6 +260,68 @@ TEST(CompactProblem, TheSweepAppliesThePercussionCriterionToItsOwnChange) {
   }
 }
 
+// The sweep's own natural-map residual (SweepReport::residual) is, contact by contact, the natural
+// map of λ_i and ξ_i as the sweep found them — recomputed here from a copy of the state before
+// each update — and zero at a solution. The natural-residual criterion reads it first and pays
+// for ‖F‖ only where it met the tolerance: SOR stops converged, with ‖F‖ within the tolerance,
+// no earlier than the first sweep whose ‖F‖ meets it (from the residual history, which evaluates
+// ‖F‖ after every sweep), and at most a few sweeps later.
+TEST(CompactProblem, TheSweepSumsItsNaturalResidualAndTheCriterionReadsIt) {
+  const Random r = random_problem(8, 24, false, 19);
+  std::vector<RFactors> rf;
+  for (const CompactContact& c : r.problem.contacts) {
+    rf.push_back(r_factors(delassus_block(c, r.problem.M_inv), 1.0));
+  }
+  std::vector<Vector6> u = r.problem.u_free;
+  std::vector<Vector3> lambda(r.problem.contacts.size(), Vector3::Zero());
+  for (int k = 0; k < 5; ++k) {
+    // The sweep by hand: contact i sees the velocities its predecessors left.
+    std::vector<Vector6> u_hand = u;
+    std::vector<Vector3> lambda_hand = lambda;
+    double sum = 0.0;
+    for (std::size_t i = 0; i < lambda.size(); ++i) {
+      const CompactContact& c = r.problem.contacts[i];
+      const Vector3 xi = contact_velocity(c, u_hand) + c.xi_A;
+      sum += natural_map(lambda_hand[i], xi, c.mu).squaredNorm();
+      std::span<Vector6> one_u(u_hand);
+      CompactProblem single = r.problem;
+      single.contacts = {c};
+      std::vector<RFactors> one_r{rf[i]};
+      std::vector<Vector3> one_l{lambda_hand[i]};
+      sor_sweep(single, one_r, ProxForm::alart_curnier, one_u, one_l);
+      lambda_hand[i] = one_l[0];
+    }
+    const SweepReport report = sor_sweep(r.problem, rf, ProxForm::alart_curnier, u, lambda,
+                                         std::numeric_limits<double>::infinity(), 0.0, true);
+    EXPECT_NEAR(report.residual, std::sqrt(sum), 1e-12 * std::sqrt(sum)) << "sweep " << k;
+    const SweepReport silent = sor_sweep(r.problem, rf, ProxForm::alart_curnier, u_hand,
+                                         lambda_hand);
+    EXPECT_EQ(silent.residual, -1.0);
+  }
+
+  SolverOptions options;
+  options.abs_tol = 0.0;
+  options.rel_tol = 1e-10;
+  options.max_iterations = 100000;
+  options.criterion = Criterion::natural_residual;
+  SolverOptions history = options;
+  history.record_history = true;
+  ContactSolution a, b;
+  const SolverResult plain = ContactSolver(Method::sor, options).solve(r.problem, a);
+  const SolverResult every = ContactSolver(Method::sor, history).solve(r.problem, b);
+  ASSERT_TRUE(plain.converged) << describe(plain);
+  ASSERT_TRUE(every.converged) << describe(every);
+  const double tolerance = options.rel_tol * plain.norm_c;
+  EXPECT_LE(plain.residual, tolerance);
+  EXPECT_GT(every.iterations, 20) << "a problem that needs many sweeps";
+  EXPECT_GE(plain.iterations, every.iterations);
+  EXPECT_LE(plain.iterations, every.iterations + every.iterations / 4 + 2);
+  const SweepReport at_solution = sor_sweep(r.problem, rf, ProxForm::alart_curnier, a.u,
+                                            a.lambda, std::numeric_limits<double>::infinity(),
+                                            0.0, true);
+  EXPECT_LE(at_solution.residual, 2.0 * tolerance);
+}
+
 // The solver's report of a compact solve, computed in one pass from the returned (Λ, u), is the
 // natural-map residual of Λ with u recomputed from Λ (velocities_from_percussions), and ‖c‖ that
 // of the free contact velocities, to rounding.

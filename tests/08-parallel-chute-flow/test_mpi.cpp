@@ -772,6 +772,65 @@ TEST(ParallelStepper, AnElasticImpactThroughThePeriodicBoundarySwapsTheVelocitie
   EXPECT_NEAR(v[0] + v[1], 0.0, 1e-12);
 }
 
+// A ring of five touching spheres, frictionless and without restitution, in a box periodic along x
+// exactly five diameters long: the first is struck at v, every contact closes at once, and the
+// converged step leaves every contact at rest, γ_N = 0, so that all move at v/5 (momentum). The
+// fifth contact is between the last sphere and the periodic image of the first. On one process
+// every image is folded onto its owner: nothing is split, and APGD and Newton solve the step as SOR
+// does; on several, the methods other than SOR are refused (split bodies need SOR's averaging).
+TEST(ParallelStepper, ARingThroughThePeriodicBoundaryMovesAsOneOnAnyMethod) {
+  const int p = world->size();
+  const double r = 0.01;
+  const int n = 5;
+  const double L = 2.0 * r * n;
+  const Box domain(Vector3(0.0, -0.05, -0.05), Vector3(L, 0.05, 0.05));
+  const CartesianGrid grid(domain, {p, 1, 1}, {true, false, false});
+  timestep::MaterialTable materials;
+  materials.set_pair(materials.add("ice"), 0, {0.0, 0.0, 0.0});
+  for (const contact::Method method :
+       {contact::Method::sor, contact::Method::apgd, contact::Method::newton}) {
+    timestep::BodySystem mine;
+    for (int i = 0; i < n; ++i) {
+      const timestep::BodyRecord body =
+          sphere(static_cast<std::uint64_t>(i + 1), r, Vector3(r + 2.0 * r * i, 0.0, 0.0),
+                 Vector3(i == 0 ? 1.0 : 0.0, 0.0, 0.0));
+      if (grid.owner_of(body.state.q.head<3>()) == world->rank()) mine.add(body);
+    }
+    const timestep::StaticGeometry statics;
+    timestep::StepSettings settings;
+    settings.dt = 1e-4;
+    settings.I_g.setZero();
+    settings.tolerance_radius = r;
+    settings.contact_tolerance = 0.01;  // the contact the first half step opens stays active
+    settings.method = method;
+    settings.solver.abs_tol = 0.0;
+    settings.solver.rel_tol = 1e-10;
+    settings.solver.criterion = contact::Criterion::natural_residual;
+    settings.solver.max_iterations = 20000;
+    if (p > 1 && method != contact::Method::sor) {
+      EXPECT_THROW(ParallelStepper(*world, grid, mine, statics, materials, settings, {r}),
+                   InvalidArgument);
+      continue;
+    }
+    ParallelStepper parallel(*world, grid, mine, statics, materials, settings, {r});
+    const timestep::StepReport report = parallel.step();
+    EXPECT_EQ(report.contacts, static_cast<std::size_t>(n)) << contact::method_name(method);
+    EXPECT_TRUE(report.converged) << contact::method_name(method) << ", residual " << report.residual << " after " << report.iterations;
+    if (p == 1) {
+      EXPECT_EQ(parallel.split_bodies(), 0u) << "images folded onto their owners";
+    }
+    std::vector<double> v(n, 0.0);
+    for (std::size_t i = 0; i < mine.owned_count(); ++i) {
+      v[mine.ids()[i] - 1] = mine.states()[i].u[0];
+    }
+    world->sum(v);
+    for (int i = 0; i < n; ++i) {
+      EXPECT_NEAR(v[static_cast<std::size_t>(i)], 1.0 / n, 1e-8)
+          << contact::method_name(method) << ", sphere " << i + 1;
+    }
+  }
+}
+
 // A pile settling from a jittered lattice in an open box, on 1, 2 and 3 processes (slices along x)
 // and serially: the same physics, so the same statistics at the end — contacts, the height of the
 // heap (potential energy), nearly at rest — though not the same bits, since splitting changes the

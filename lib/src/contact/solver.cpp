@@ -477,6 +477,8 @@ class CompactModel {
     ws_.v.assign(problem_.u_free.begin(), problem_.u_free.end());
     contact_velocities_of(ws_.v, xi);
   }
+  /// ξ from the body velocities as they are (SOR keeps them in step with Λ).
+  void current_velocities(std::vector<Vector3>& xi) const { contact_velocities_of(u_, xi); }
   void apply_G(std::span<const Vector3> x, std::vector<Vector3>& y) {
     std::vector<Vector6>& v = ws_.v;
     v.assign(problem_.M_inv.size(), Vector6::Zero());
@@ -495,9 +497,16 @@ class CompactModel {
   }
   void done() { synchronize(); }
   void sor_sweep(std::span<const RFactors> r, ProxForm form) {
-    sweep_ = contact::sor_sweep(problem_, r, form, u_, lambda_, change_abs_, change_rel_);
+    sweep_ = contact::sor_sweep(problem_, r, form, u_, lambda_, change_abs_, change_rel_,
+                                residual_in_sweep_);
     sweep_fresh_ = true;
+    residual_fresh_ = true;
   }
+  /// Whether the next sweeps also sum the natural map of the contacts they update
+  /// (SweepReport::residual), which the natural-residual criterion reads before it pays for ‖F‖.
+  void sum_residual_in_sweep(bool on) { residual_in_sweep_ = on; }
+  /// The last sweep's natural-map residual, or −1 when it was not summed or Λ was changed since.
+  double sweep_residual() const { return residual_fresh_ ? sweep_.residual : -1.0; }
   /// From now on each sweep also applies the percussion criterion to its own change of Λ (the
   /// monitor then keeps no copy of Λ).
   void test_change_in_sweep(double abs_tol, double rel_tol) {
@@ -561,7 +570,10 @@ class CompactModel {
     return all_finite(lambda_);
   }
   /// The hook may have changed Λ: the sweep's test no longer speaks for it.
-  void touched() { sweep_fresh_ = false; }
+  void touched() {
+    sweep_fresh_ = false;
+    residual_fresh_ = false;
+  }
 
  private:
   void body_velocities(std::span<const Vector3> lambda, std::vector<Vector6>& u) const {
@@ -583,6 +595,8 @@ class CompactModel {
   SweepReport sweep_;
   double change_abs_ = std::numeric_limits<double>::infinity();  // no test unless asked
   double change_rel_ = 0.0;
+  bool residual_in_sweep_ = false;
+  bool residual_fresh_ = false;  // sweep_.residual is that of the last sweep, Λ untouched since
 };
 
 /// How the power iteration starts.
@@ -662,14 +676,18 @@ template <class Model>
 class Monitor {
  public:
   /// result.norm_c must be set (Model::prepare()). With `change_in_sweep` the model's sweep
-  /// applies the percussion criterion itself (Model::sweep_settled()) and no copy of Λ is kept.
+  /// applies the percussion criterion itself (Model::sweep_settled()) and no copy of Λ is kept,
+  /// or sums the natural-map residual of its updates (Model::sweep_residual()).
+  /// `reference` is ‖c‖ of the whole problem and `share` the part of the natural-residual
+  /// tolerance this process may use (SolverHooks::global_norm_c; 1 alone).
   Monitor(Model& model, const SolverOptions& options, Workspace& ws, SolverResult& result,
-          bool change_in_sweep)
+          bool change_in_sweep, double reference, double share)
       : model_(model),
         options_(options),
         ws_(ws),
         result_(result),
-        change_in_sweep_(change_in_sweep) {
+        change_in_sweep_(change_in_sweep),
+        tolerance_((options.abs_tol + options.rel_tol * reference) * share) {
     // μ for the natural map of the iterations, where it is read.
     if (options.record_history || options.criterion == Criterion::natural_residual) {
       gather_mu(model, ws);
@@ -688,6 +706,11 @@ class Monitor {
     if (options_.criterion == Criterion::velocity_change) {
       const auto v = model_.watched_velocity();
       ws_.velocity_old.assign(v.begin(), v.end());
+    }
+    if constexpr (requires { model_.sum_residual_in_sweep(true); }) {
+      if (change_in_sweep_ && options_.criterion == Criterion::natural_residual) {
+        model_.sum_residual_in_sweep(k >= next_residual_);
+      }
     }
   }
 
@@ -709,7 +732,14 @@ class Monitor {
     // Before min_iterations the criterion is not evaluated (before() saved nothing for it).
     if (k < options_.min_iterations) return Verdict::not_met;
     if (options_.criterion == Criterion::natural_residual && residual < 0.0) {
+      // A sweep that summed its own residual: ‖F‖ is evaluated only once that sum has met the
+      // tolerance (both vanish together at the solution), which saves a pass over the contacts
+      // and the bodies in every sweep but the last few.
+      if constexpr (requires { model_.sweep_residual(); }) {
+        if (change_in_sweep_ && !sweep_residual_met(k)) return Verdict::not_met;
+      }
       residual = natural_residual();
+      next_residual_ = k + 1;  // a sweep that met it but ‖F‖ not: look again at the next
     }
     bool met = false;
     switch (options_.criterion) {
@@ -728,14 +758,44 @@ class Monitor {
                             options_.rel_tol);
         break;
       case Criterion::natural_residual:
-        met = residual <= options_.abs_tol + options_.rel_tol * result_.norm_c;
+        met = residual <= tolerance_;
         break;
     }
     return met && k >= options_.min_iterations ? Verdict::met : Verdict::not_met;
   }
 
-  /// ‖F(Λ)‖ of the current percussions.
+  /// The sweeps' own residual (SOR): summing it costs about half a sweep, so the sweeps sum it
+  /// only where it may have met the tolerance. From two sums r₁ (sweep k₁) and r₂ (sweep k₂) the
+  /// rate ρ = (r₂/r₁)^{1/(k₂−k₁)} predicts the sweeps n = ln(tol/r₂)/ln ρ still needed; the next
+  /// sum is taken after half of them (1 to kMaxResidualStride sweeps), every sweep once within
+  /// reach. True when this sweep summed its residual and it met the tolerance.
+  bool sweep_residual_met(int k) {
+    static constexpr int kMaxResidualStride = 16;
+    const double r = model_.sweep_residual();
+    if (r < 0.0) return false;  // not summed in this sweep
+    const double tol = tolerance_;
+    if (r <= tol) return true;
+    int stride = 1;
+    if (last_residual_ > 0.0 && r < last_residual_) {
+      const double rate = std::log(r / last_residual_) / (k - last_residual_sweep_);
+      const double needed = std::log(tol / r) / rate;
+      stride = static_cast<int>(std::clamp(needed / 2.0, 1.0, double{kMaxResidualStride}));
+    }
+    last_residual_ = r;
+    last_residual_sweep_ = k;
+    next_residual_ = k + stride;
+    return false;
+  }
+
+  /// ‖F(Λ)‖ of the current percussions. SOR's sweeps keep u in step with Λ, and a hook may have
+  /// changed u since (the averaged velocities of split bodies, chapter 8): ξ from that u.
   double natural_residual() {
+    if constexpr (requires { model_.current_velocities(ws_.xi); }) {
+      if (change_in_sweep_) {
+        model_.current_velocities(ws_.xi);
+        return residual_norm(model_.lambda(), ws_.xi, ws_.mu);
+      }
+    }
     model_.velocities(model_.lambda(), ws_.xi);
     return residual_norm(model_.lambda(), ws_.xi, ws_.mu);
   }
@@ -750,6 +810,10 @@ class Monitor {
   Workspace& ws_;
   SolverResult& result_;
   bool change_in_sweep_;
+  double tolerance_;             // of the natural-residual criterion, this process's share
+  int next_residual_ = 0;        // the next sweep that sums its residual
+  double last_residual_ = -1.0;  // the last sum, and its sweep
+  int last_residual_sweep_ = 0;
 };
 
 /// SOR: one Gauss–Seidel sweep per iteration; u is always in step with Λ.
@@ -1364,8 +1428,19 @@ SolverResult run(Method method, Model& model, const SolverOptions& options,
       model.test_change_in_sweep(options.abs_tol, options.rel_tol);
       change_in_sweep = true;
     }
+    if (method == Method::sor && !hooks.after_iteration &&
+        options.criterion == Criterion::natural_residual) {
+      change_in_sweep = true;  // the monitor asks the sweeps for their residual
+    }
   }
-  Monitor<Model> monitor(model, options, ws, result, change_in_sweep);
+  double reference = result.norm_c;
+  double share = 1.0;
+  if (hooks.global_norm_c) {
+    const GlobalNorm global = hooks.global_norm_c(result.norm_c);
+    reference = global.norm_c;
+    share = 1.0 / std::sqrt(static_cast<double>(std::max(1, global.processes)));
+  }
+  Monitor<Model> monitor(model, options, ws, result, change_in_sweep, reference, share);
   switch (method) {
     case Method::sor: {
       SorPolicy<Model> policy(model, options, ws);

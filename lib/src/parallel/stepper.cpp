@@ -30,6 +30,7 @@ ParallelStepper::ParallelStepper(const Communicator& comm, const Partition& part
       imbalance_(parallel.imbalance),
       margin_(ghost_margin(settings)),
       max_radius_(parallel.max_radius),
+      averages_(settings.method == contact::Method::sor),
       partition_(partition.clone()) {
   exchange_.emplace(comm, *partition_, margin_, max_radius_);
   if (parallel.rebalance_every < 0 || !(parallel.imbalance >= 1.0)) {
@@ -55,10 +56,21 @@ ParallelStepper::ParallelStepper(const Communicator& comm, const Partition& part
   hooks.after_assembly = [this](contact::CompactProblem& problem, contact::ContactSolution&) {
     split_masses(problem);
   };
-  hooks.solver.velocities_between_sweeps = [this](int k, std::span<Vector6> u) {
-    sweep_ = k;
-    if (k % average_every_ == 0 || k == max_iterations_) average_split_velocities(u);
-  };
+  // Split bodies need SOR (their copies' velocities are averaged between its sweeps). On one
+  // process every ghost is a periodic image of a body owned here and is folded onto it, so any
+  // method runs there.
+  if (averages_) {
+    hooks.solver.velocities_between_sweeps = [this](int k, std::span<Vector6> u) {
+      sweep_ = k;
+      if (k % average_every_ == 0 || k == max_iterations_) average_split_velocities(u);
+    };
+  } else if (comm.size() > 1) {
+    throw InvalidArgument(
+        "ParallelStepper: method " + std::string(contact::method_name(settings.method)) +
+        " on " + std::to_string(comm.size()) +
+        " processes: the bodies split between processes need method SOR, whose sweeps their "
+        "copies' velocities are averaged between (one process runs any method)");
+  }
   hooks.solver.global_status = [this](contact::IterationStatus local) {
     // The verdict is taken after the averaged sweeps only, where the copies of every split body
     // agree: one reduction every average_every sweeps (and at the last sweep the solver may do),
@@ -69,6 +81,11 @@ ParallelStepper::ParallelStepper(const Communicator& comm, const Partition& part
     double status[1] = {static_cast<double>(local)};
     comm_.max(status);
     return static_cast<contact::IterationStatus>(static_cast<int>(status[0]));
+  };
+  hooks.solver.global_norm_c = [this](double norm_c) {
+    double squares[1] = {norm_c * norm_c};
+    comm_.sum(squares);
+    return contact::GlobalNorm{std::sqrt(squares[0]), comm_.size()};
   };
   hooks.reduce_report = [this](timestep::StepReport& report) { reduce(report); };
   stepper_ = std::make_unique<timestep::MoreauStepper>(system, statics, materials, settings,
@@ -185,14 +202,34 @@ void ParallelStepper::select_contacts(const timestep::BodySystem& system,
   timestep::keep_contacts_if(contacts, keys, [&](const timestep::DetectedContact& c) {
     return solves_contact(system, c);
   });
-  // The copies of each body: its owner's, and each ghost that takes part in a kept contact.
+  // A ghost that is a periodic image of a body owned here is that body, moved by a period: its
+  // side of the contact is folded onto the owner (fold_images), and the body is not split. The
+  // copies of each body: its owner's, and each ghost of another process's body that takes part
+  // in a kept contact.
   const std::size_t n = system.size();
   copies_.assign(n, 0.0);
-  for (const timestep::DetectedContact& c : contacts) {
-    for (const int row : {c.row_a, c.row_b}) {
-      if (row >= 0 && !system.owned(static_cast<std::size_t>(row)) &&
-          system.dynamic(static_cast<std::size_t>(row))) {
-        copies_[static_cast<std::size_t>(row)] = 1.0;
+  folds_.clear();
+  for (std::size_t k = 0; k < contacts.size(); ++k) {
+    const timestep::DetectedContact& c = contacts[k];
+    for (const int side : {0, 1}) {
+      const int row = side == 0 ? c.row_a : c.row_b;
+      if (row < 0 || system.owned(static_cast<std::size_t>(row)) ||
+          !system.dynamic(static_cast<std::size_t>(row))) {
+        continue;
+      }
+      const std::size_t owner = system.index_of(system.ids()[static_cast<std::size_t>(row)]);
+      const int other = side == 0 ? c.row_b : c.row_a;
+      if (owner == timestep::BodySystem::npos) {
+        copies_[static_cast<std::size_t>(row)] = 1.0;  // another process's body
+      } else if (static_cast<int>(owner) != other) {
+        folds_.push_back({k, side, static_cast<collision::BodyIndex>(owner)});
+      } else if (averages_) {
+        copies_[static_cast<std::size_t>(row)] = 1.0;  // a body touching its own image: split
+      } else {
+        throw Error("ParallelStepper: step " + std::to_string(stepper_->steps() + 1) + ": body " +
+                    std::to_string(system.ids()[static_cast<std::size_t>(row)]) +
+                    " touches its own periodic image, which only SOR's mass splitting solves: "
+                    "make the periods longer than a body, or use method = \"sor\"");
       }
     }
   }
@@ -220,6 +257,12 @@ void ParallelStepper::select_contacts(const timestep::BodySystem& system,
 
 // [split masses]
 void ParallelStepper::split_masses(contact::CompactProblem& problem) {
+  // A folded side: the owner's index, the lever arm from the image's centre as assembled (the
+  // image is the owner translated, with its orientation and velocity).
+  for (const Fold& f : folds_) {
+    contact::CompactContact& cc = problem.contacts[f.contact];
+    (f.side == 0 ? cc.body_a : cc.body_b) = f.owner;
+  }
   // A copy of a body with m copies carries the mass M/m: its inverse mass is m M⁻¹. Its load is
   // scaled alike, so its free velocity u + Δt M⁻¹ h does not change.
   for (std::size_t i = 0; i < copies_.size(); ++i) {

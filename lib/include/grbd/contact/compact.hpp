@@ -118,20 +118,27 @@ struct SweepReport {
   /// Every component of every λ moved by at most abs_tol + rel_tol |λ_new|: has_converged() of
   /// the sweep's own change, without a copy of Λ (always true with the default tolerances).
   bool settled = true;
+  /// With `residual` asked: the natural-map residual of the sweep, (Σ_i ‖F(λ_i, ξ_i)‖²)^½ with
+  /// each contact's λ_i and ξ_i as the sweep found them before updating it (the contacts before
+  /// it updated, those after it not yet) — not the residual of any one iterate, but zero exactly
+  /// at a solution and tending to zero with ‖F‖, at the cost of one cone projection per contact;
+  /// −1 when not asked.
+  double residual = -1.0;
 };
 
 /// One Gauss–Seidel sweep over a compact problem: for contacts 0, 1, …, n − 1 in order, the
 /// contact velocity seen now, ξ = γ + xi_A, the prox update of `form` (as sor_contact_update()
 /// of chapter 5), and the body velocities follow the change at once. Reports whether every
 /// updated percussion is finite and whether the change of each stayed within
-/// abs_tol + rel_tol |λ_new| (the percussion criterion of the solvers, evaluated in the sweep).
+/// abs_tol + rel_tol |λ_new| (the percussion criterion of the solvers, evaluated in the sweep),
+/// and, with `residual`, the natural-map residual of the sweep (SweepReport::residual).
 /// Throws InvalidArgument unless r and lambda have one entry per contact and u one per body
 /// (O(1)); the contacts themselves are not re-checked: `problem` must be one that validate()
 /// accepted.
 SweepReport sor_sweep(const CompactProblem& problem, std::span<const RFactors> r, ProxForm form,
                       std::span<Vector6> u, std::span<Vector3> lambda,
                       double abs_tol = std::numeric_limits<double>::infinity(),
-                      double rel_tol = 0.0);
+                      double rel_tol = 0.0, bool residual = false);
 // [compact sweep declaration]
 
 }  // namespace grbd::contact

@@ -249,8 +249,15 @@ enum class IterationStatus : int {
   diverged = 2,   ///< an iterate is not finite: stop
 };
 
+/// The natural-residual criterion's reference on many processes (SolverHooks::global_norm_c).
+struct GlobalNorm {
+  double norm_c = 0.0;  ///< ‖c‖ of the whole problem, (Σ_p ‖c_p‖²)^½
+  int processes = 1;    ///< the number of processes P that share the problem
+};
+
 /// Where a distributed solver (chapter 8) plugs into the iteration of every method: split-body
-/// averaging after each sweep, and a global convergence verdict. Empty members are not called.
+/// averaging after each sweep, the tolerance's reference and a global convergence verdict.
+/// Empty members are not called.
 struct SolverHooks {
   /// Called after every iteration k = 1, 2, …, iterations (1-based), before the stopping test,
   /// with Λ and, in the body form, the body velocities u (empty in the local form). SOR keeps u in
@@ -278,6 +285,12 @@ struct SolverHooks {
   /// a non-finite iterate. The solver follows what the hook returns; a global `diverged` sets
   /// SolverResult::diverged on every process.
   std::function<IterationStatus(IterationStatus local)> global_status;
+  /// For a problem shared by processes: called once per solve, collectively, with this process's
+  /// ‖c‖; returns the whole problem's ‖c‖ and the number of processes P. The natural-residual
+  /// criterion then holds each process to (abs_tol + rel_tol ‖c‖)/√P, so that the processes'
+  /// residuals together, (Σ_p ‖F_p‖²)^½, meet the tolerance of the whole problem — and a process
+  /// whose own contacts have c = 0 is not held to ‖F_p‖ = 0. SOR's body and compact forms.
+  std::function<GlobalNorm(double norm_c)> global_norm_c;
 };
 
 namespace detail {

@@ -49,6 +49,11 @@ struct ParallelSettings {
 /// (StepSettings::skin; 0 rebuilds at every step). In the step:
 /// - after detection, a contact is kept only by the process that owns its side a (a static side a:
 ///   side b), so that each contact is solved exactly once;
+/// - a ghost that is a periodic image of a body owned by the same process is that body, translated
+///   by a period: its side of a kept contact is folded onto the owner (the contact's body index
+///   becomes the owner's, the lever arm stays the one from the image's centre), so that one
+///   process, periodic or not, solves the serial problem — with any method — and P processes
+///   split only the bodies that other processes touch;
 /// - a body whose ghost copies take part in kept contacts on other processes is split: each of its
 ///   m copies (the owner's and the active ghosts) carries the mass M/m, and after every sweep the
 ///   copies' velocities are replaced by their mean, the velocity all copies share at the solution
@@ -120,6 +125,7 @@ class ParallelStepper final : public scene::StepEngine {
   double imbalance_;
   double margin_;      // of the ghosts: contact margin + skin [m]
   double max_radius_;  // the largest bounding radius of the run [m]
+  bool averages_;      // SOR: split bodies' velocities are averaged between sweeps
   std::unique_ptr<Partition> partition_;
   std::optional<BodyExchange> exchange_;  // over *partition_
   std::unique_ptr<timestep::MoreauStepper> stepper_;
@@ -129,6 +135,13 @@ class ParallelStepper final : public scene::StepEngine {
   std::vector<double> velocities_;       // per row: 6 doubles for the averaging
   std::vector<std::uint8_t> split_;      // per row: 1 for a split body's row (owner or copy)
   std::vector<std::size_t> split_rows_;  // those rows, ascending
+  /// A side of a kept contact that is a periodic image of a body owned here, folded onto it.
+  struct Fold {
+    std::size_t contact;           // index among the kept contacts
+    int side;                      // 0: a, 1: b
+    collision::BodyIndex owner;    // the owner's row
+  };
+  std::vector<Fold> folds_;
   std::uint64_t rebuilds_ = 0;
   std::uint64_t rebalances_ = 0;
   double averaging_seconds_ = 0.0;

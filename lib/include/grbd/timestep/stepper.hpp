@@ -147,7 +147,9 @@ struct StepHooks {
   /// at q_M, u_free, the contacts with their frames, lever arms, μ and ξ_A) and the initial guess
   /// (solution.lambda, warm-started; solution.u holds u_S in frame I). May change the inverse
   /// masses and free velocities of bodies (a split body's copy carries M⁻¹ scaled by its
-  /// multiplicity) and the guess; must not change the number or the order of bodies or contacts.
+  /// multiplicity) and the guess, and fold a contact's side from a body onto another that moves
+  /// with it (a periodic image onto its owner, the lever arm kept); must not change the number or
+  /// the order of bodies or contacts.
   std::function<void(contact::CompactProblem& problem, contact::ContactSolution& solution)>
       after_assembly;
   /// The contact solver's own hooks, given to its ContactSolver: between iterations
