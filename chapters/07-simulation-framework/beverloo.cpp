@@ -25,6 +25,7 @@
 
 #include "grbd/body/triangle_mesh.hpp"
 #include "grbd/collision/static_mesh.hpp"
+#include "grbd/io/output.hpp"
 #include "grbd/scene/measure.hpp"
 #include "grbd/scene/scene.hpp"
 #include "grbd/scene/simulation.hpp"
@@ -43,6 +44,7 @@ struct Discharge {
   double D = 0.0;                       // orifice diameter [m]
   std::vector<double> t, mass;          // discharged mass after each step [s, kg]
   grbd::scene::Rate W;                  // the steady rate [kg/s]
+  grbd::io::RunAccuracy accuracy;       // the solver's convergence and the overlaps, every step
   double rho_b = 0.0;                   // bulk density of the fill [kg/m³]
   std::uint64_t bodies = 0, steps = 0;  // at the end
   double seconds = 0.0;
@@ -76,7 +78,7 @@ Discharge discharge(const grbd::scene::Scene& base, double D, double t_start, do
   std::size_t samples = 0;
   const auto start = std::chrono::steady_clock::now();
   while (!sim.finished()) {
-    sim.step();
+    out.accuracy.add(sim.step());
     sim.created().clear();  // no output: nobody needs the new bodies' constants
     const double t = sim.stepper().time();
     out.t.push_back(t);
@@ -91,6 +93,7 @@ Discharge discharge(const grbd::scene::Scene& base, double D, double t_start, do
   out.W = grbd::scene::steady_rate(out.t, out.mass, t_start);
   out.bodies = sim.system().size();
   out.steps = sim.stepper().steps();
+  out.accuracy.unit = sim.stepper().overlap_unit();
   return out;
 }
 
@@ -194,6 +197,13 @@ int main(int argc, char** argv) {
       values.set(key + "rho_b", "%.0f", r.rho_b);
       values.set(key + "literature", "%.1f", literature * 1e3);
       values.set(key + "ratio", "%.2f", r.W.rate / literature);
+      const grbd::io::RunAccuracy& a = r.accuracy;
+      values.set(key + "converged", "%.0f",
+                 100.0 * static_cast<double>(a.converged) / static_cast<double>(a.steps));
+      values.set(key + "sweeps", "%.0f",
+                 static_cast<double>(a.sweeps) / static_cast<double>(a.steps));
+      values.set(key + "p99", "%.1f", 1e6 * a.p99_overlap());
+      values.set(key + "largest", "%.0f", 1e6 * a.max_overlap);
       worst = std::max(worst, std::abs(r.W.rate / literature - 1.0));
     }
     values.set("C", "%.2f", fit.C);

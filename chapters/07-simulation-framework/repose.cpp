@@ -18,6 +18,7 @@
 #include <string>
 #include <vector>
 
+#include "grbd/io/output.hpp"
 #include "grbd/scene/measure.hpp"
 #include "grbd/scene/scene.hpp"
 #include "grbd/scene/simulation.hpp"
@@ -57,6 +58,7 @@ struct Heap {
   std::uint64_t fell = 0;
   double max_speed = 0.0;  // of a bead when the run stopped [m/s]
   double seconds = 0.0;
+  grbd::io::RunAccuracy accuracy;  // the solver's convergence and the overlaps, every step
 };
 
 }  // namespace
@@ -107,6 +109,7 @@ int main(int argc, char** argv) {
       while (!sim.finished()) {
         const auto report = sim.step();
         sim.created().clear();  // no output
+        heap.accuracy.add(report);
         if (report.step % steps_per_trace == 0 && report.t > 0.5) {
           measure(sim, heap);
           relax << report.t << ' ' << heap.fit.angle << '\n';
@@ -123,6 +126,7 @@ int main(int argc, char** argv) {
           std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
       measure(sim, heap);
       heap.fell = sim.bodies_removed();
+      heap.accuracy.unit = sim.stepper().overlap_unit();
       for (std::size_t i = 0; i < sim.system().size(); ++i) heap.beads += sim.system().dynamic(i);
       heap.max_speed = grbd::scene::max_speed(sim.system());
       std::cout << kProgram << ": mu = " << mu << ": angle " << heap.fit.angle << " ± "
@@ -178,6 +182,13 @@ int main(int argc, char** argv) {
       values.set(std::string(key) + "beads", "%zu", h.beads);
       values.set(std::string(key) + "rest", "%.2f", h.rest);
       values.set(std::string(key) + "fastest", "%s", grbd::demo::tex_power(h.max_speed).c_str());
+      const grbd::io::RunAccuracy& a = h.accuracy;
+      values.set(std::string(key) + "converged", "%.0f",
+                 100.0 * static_cast<double>(a.converged) / static_cast<double>(a.steps));
+      values.set(std::string(key) + "sweeps", "%.0f",
+                 static_cast<double>(a.sweeps) / static_cast<double>(a.steps));
+      values.set(std::string(key) + "p99", "%.1f", 1e6 * a.p99_overlap());
+      values.set(std::string(key) + "largest", "%.0f", 1e6 * a.max_overlap);
       if (h.mu >= 0.3) {
         lo = std::min(lo, h.fit.angle);
         hi = std::max(hi, h.fit.angle);
