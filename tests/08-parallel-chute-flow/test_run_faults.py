@@ -3,7 +3,8 @@
 on one process and under mpiexec: the stop file is none of the run's files and a fresh one is
 never taken as stale; an error only one process meets (its scene, its options) ends the job with
 one message; a full disk ends every process with exit code 1 and leaves files that open; one
-message per job; `grbd chute --csv` replaces only a regular file that is none of the run's.
+message per job; `grbd chute --csv` replaces only a regular file that is none of the run's; a
+method other than SOR runs on one process and is refused, with one message, on two.
 
 Usage: test_run_faults.py GRBD MPIEXEC TINY_CHUTE [unittest options]. Needs python3 and h5py."""
 
@@ -138,6 +139,27 @@ class Faults(unittest.TestCase):
             for word in words:
                 self.assertIn(word, lines[0])
             self.assertFalse(os.path.exists(self.path("o.h5")), "nothing is written")
+
+    def test_a_method_other_than_sor_runs_on_one_process_and_is_refused_on_two(self):
+        # Split bodies need SOR's averaging between sweeps; one process splits nothing (periodic
+        # images are folded onto their owners), so it runs any method.
+        with open(CHUTE) as f:
+            text = f.read()
+        apgd = text.replace('method = "sor"', 'method = "apgd"', 1)
+        self.assertNotEqual(apgd, text)
+        with open(self.scene, "w") as f:
+            f.write(apgd)
+        result = grbd(0, "run", self.scene, "-q", "-o", self.path("a.h5"), "-c",
+                      self.path("a.c.h5"), "--end-time", "0.002")
+        self.assertEqual(result.returncode, 0, result.stderr)
+        result = grbd(2, "run", self.scene, "-q", "-o", self.path("b.h5"), "-c",
+                      self.path("b.c.h5"), "--end-time", "0.002")
+        self.assertEqual(result.returncode, 3, result.stderr)
+        lines = messages(result.stderr)
+        self.assertEqual(len(lines), 1, result.stderr)
+        for word in ("k.toml", "method APGD on 2 processes", "SOR"):
+            self.assertIn(word, lines[0])
+        self.assertFalse(os.path.exists(self.path("b.h5")), "nothing is written")
 
     def mount_small_disk(self, name):
         folder = self.path(name)
