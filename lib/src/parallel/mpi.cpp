@@ -316,6 +316,22 @@ void MpiEnvironment::end_now(int exit_code) const {
   std::cout.flush();
   std::cerr.flush();
   std::fflush(nullptr);
+  // The processes leave together: a process that ended first would make mpiexec kill the others,
+  // rank 0 among them before it wrote the job's one message. A non-blocking barrier, waited for
+  // at most kEndWait: a process that never comes (it did not meet the failure) cannot hold the
+  // others. MPI itself is intact; only HDF5's collective state is apart.
+  if (world_ && world_->size() > 1) {
+    constexpr auto kEndWait = std::chrono::seconds(10);
+    MPI_Request request = MPI_REQUEST_NULL;
+    if (MPI_Ibarrier(MPI_COMM_WORLD, &request) == MPI_SUCCESS) {
+      const auto deadline = std::chrono::steady_clock::now() + kEndWait;
+      int done = 0;
+      while (MPI_Test(&request, &done, MPI_STATUS_IGNORE) == MPI_SUCCESS && done == 0 &&
+             std::chrono::steady_clock::now() < deadline) {
+        std::this_thread::sleep_for(std::chrono::milliseconds(1));
+      }
+    }
+  }
   std::_Exit(exit_code);
 }
 

@@ -203,7 +203,7 @@ void ParallelStepper::select_contacts(const timestep::BodySystem& system,
     return solves_contact(system, c);
   });
   // A ghost that is a periodic image of a body owned here is that body, moved by a period: its
-  // side of the contact is folded onto the owner (fold_images), and the body is not split. The
+  // side of the contact is folded onto the owner (split_masses), and the body is not split. The
   // copies of each body: its owner's, and each ghost of another process's body that takes part
   // in a kept contact.
   const std::size_t n = system.size();

@@ -79,7 +79,8 @@ class MpiEnvironment {
   /// Ends this process now with `exit_code`, its output streams flushed, without finalizing MPI
   /// or closing HDF5: what every process of a run does after a collective write failed
   /// (io::AbandonedFiles), where HDF5's collective clean-up inside MPI_Finalize would hang or
-  /// crash. The files hold what their last flush wrote.
+  /// crash. The files hold what their last flush wrote. With several processes each first waits
+  /// (at most 10 s) until all have come here, so that none ends before rank 0 said why.
   [[noreturn]] void end_now(int exit_code) const;
 
  private:
