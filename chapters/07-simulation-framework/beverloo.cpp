@@ -198,10 +198,8 @@ int main(int argc, char** argv) {
       values.set(key + "literature", "%.1f", literature * 1e3);
       values.set(key + "ratio", "%.2f", r.W.rate / literature);
       const grbd::io::RunAccuracy& a = r.accuracy;
-      values.set(key + "converged", "%.0f",
-                 100.0 * static_cast<double>(a.converged) / static_cast<double>(a.steps));
-      values.set(key + "sweeps", "%.0f",
-                 static_cast<double>(a.sweeps) / static_cast<double>(a.steps));
+      values.set(key + "converged", "%.0f", a.converged_percent());
+      values.set(key + "sweeps", "%.0f", a.mean_sweeps());
       values.set(key + "p99", "%.1f", 1e6 * a.p99_overlap());
       values.set(key + "largest", "%.0f", 1e6 * a.max_overlap);
       worst = std::max(worst, std::abs(r.W.rate / literature - 1.0));

@@ -183,10 +183,8 @@ int main(int argc, char** argv) {
       values.set(std::string(key) + "rest", "%.2f", h.rest);
       values.set(std::string(key) + "fastest", "%s", grbd::demo::tex_power(h.max_speed).c_str());
       const grbd::io::RunAccuracy& a = h.accuracy;
-      values.set(std::string(key) + "converged", "%.0f",
-                 100.0 * static_cast<double>(a.converged) / static_cast<double>(a.steps));
-      values.set(std::string(key) + "sweeps", "%.0f",
-                 static_cast<double>(a.sweeps) / static_cast<double>(a.steps));
+      values.set(std::string(key) + "converged", "%.0f", a.converged_percent());
+      values.set(std::string(key) + "sweeps", "%.0f", a.mean_sweeps());
       values.set(std::string(key) + "p99", "%.1f", 1e6 * a.p99_overlap());
       values.set(std::string(key) + "largest", "%.0f", 1e6 * a.max_overlap);
       if (h.mu >= 0.3) {

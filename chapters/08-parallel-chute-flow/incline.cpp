@@ -246,8 +246,8 @@ void measure_all(const std::filesystem::path& dir, const grbd::scene::Scene& bas
       p99.push_back(steps[k].p99_penetration);
     }
     flow.penetration = late.max_overlap;
-    flow.sweeps = static_cast<double>(late.sweeps) / static_cast<double>(late.steps);
-    flow.converged = 100.0 * static_cast<double>(late.converged) / static_cast<double>(late.steps);
+    flow.sweeps = late.mean_sweeps();
+    flow.converged = late.converged_percent();
     flow.mean_overlap = late.mean_overlap();
     std::nth_element(p99.begin(), p99.begin() + static_cast<std::ptrdiff_t>(p99.size() / 2),
                      p99.end());

@@ -678,16 +678,15 @@ class Monitor {
   /// result.norm_c must be set (Model::prepare()). With `change_in_sweep` the model's sweep
   /// applies the percussion criterion itself (Model::sweep_settled()) and no copy of Λ is kept,
   /// or sums the natural-map residual of its updates (Model::sweep_residual()).
-  /// `reference` is ‖c‖ of the whole problem and `share` the part of the natural-residual
-  /// tolerance this process may use (SolverHooks::global_norm_c; 1 alone).
+  /// `tolerance` is the natural-residual criterion's, this process's share of it (run()).
   Monitor(Model& model, const SolverOptions& options, Workspace& ws, SolverResult& result,
-          bool change_in_sweep, double reference, double share)
+          bool change_in_sweep, double tolerance)
       : model_(model),
         options_(options),
         ws_(ws),
         result_(result),
         change_in_sweep_(change_in_sweep),
-        tolerance_((options.abs_tol + options.rel_tol * reference) * share) {
+        tolerance_(tolerance) {
     // μ for the natural map of the iterations, where it is read.
     if (options.record_history || options.criterion == Criterion::natural_residual) {
       gather_mu(model, ws);
@@ -773,12 +772,11 @@ class Monitor {
     static constexpr int kMaxResidualStride = 16;
     const double r = model_.sweep_residual();
     if (r < 0.0) return false;  // not summed in this sweep
-    const double tol = tolerance_;
-    if (r <= tol) return true;
+    if (r <= tolerance_) return true;
     int stride = 1;
     if (last_residual_ > 0.0 && r < last_residual_) {
       const double rate = std::log(r / last_residual_) / (k - last_residual_sweep_);
-      const double needed = std::log(tol / r) / rate;
+      const double needed = std::log(tolerance_ / r) / rate;
       stride = static_cast<int>(std::clamp(needed / 2.0, 1.0, double{kMaxResidualStride}));
     }
     last_residual_ = r;
@@ -1029,9 +1027,12 @@ class ApgdPolicy {
 template <class Model>
 class NewtonPolicy {
  public:
-  NewtonPolicy(Model& model, const SolverOptions& options, Workspace& ws, SolverResult& result)
+  /// `tolerance`: the natural-residual criterion's (run()).
+  NewtonPolicy(Model& model, const SolverOptions& options, Workspace& ws, SolverResult& result,
+               double tolerance)
       : model_(model),
         options_(options),
+        tolerance_(tolerance),
         velocity_watched_(options.criterion == Criterion::velocity_change),
         ws_(ws),
         result_(result) {
@@ -1132,7 +1133,7 @@ class NewtonPolicy {
     const double residual = residual_norm(lambda, ws_.xi, ws_.mu);
     if (options_.record_history && !result_.history.empty()) result_.history.back() = residual;
     if (options_.criterion == Criterion::natural_residual) {
-      return residual <= options_.abs_tol + options_.rel_tol * result_.norm_c;
+      return residual <= tolerance_;
     }
     return has_converged(flat(std::span<const Vector3>(ws_.trial)),
                          flat(std::span<const Vector3>(lambda)), options_.abs_tol,
@@ -1149,9 +1150,8 @@ class NewtonPolicy {
   void hybrid_phase() {
     const NewtonOptions& o = options_.newton;
     double window_residual = 0.0;  // ‖F‖ at the end of the last window
-    const double tolerance = options_.criterion == Criterion::natural_residual
-                                 ? options_.abs_tol + options_.rel_tol * result_.norm_c
-                                 : -1.0;
+    const double tolerance =
+        options_.criterion == Criterion::natural_residual ? tolerance_ : -1.0;
     const bool percussions = options_.criterion == Criterion::percussion_change;
     while (result_.hybrid_sweeps < o.hybrid_sweeps) {
       const bool last_of_window = (result_.hybrid_sweeps + 1) % newton::kHybridWindow == 0;
@@ -1343,6 +1343,7 @@ class NewtonPolicy {
 
   Model& model_;
   const SolverOptions& options_;
+  double tolerance_;  // of the natural-residual criterion
   bool velocity_watched_;
   Workspace& ws_;
   SolverResult& result_;
@@ -1433,6 +1434,8 @@ SolverResult run(Method method, Model& model, const SolverOptions& options,
       change_in_sweep = true;  // the monitor asks the sweeps for their residual
     }
   }
+  // The natural-residual tolerance, abs_tol + rel_tol ‖c‖; a problem shared by processes holds
+  // each to its share of the whole problem's (SolverHooks::global_norm_c).
   double reference = result.norm_c;
   double share = 1.0;
   if (hooks.global_norm_c) {
@@ -1440,7 +1443,8 @@ SolverResult run(Method method, Model& model, const SolverOptions& options,
     reference = global.norm_c;
     share = 1.0 / std::sqrt(static_cast<double>(std::max(1, global.processes)));
   }
-  Monitor<Model> monitor(model, options, ws, result, change_in_sweep, reference, share);
+  const double tolerance = (options.abs_tol + options.rel_tol * reference) * share;
+  Monitor<Model> monitor(model, options, ws, result, change_in_sweep, tolerance);
   switch (method) {
     case Method::sor: {
       SorPolicy<Model> policy(model, options, ws);
@@ -1458,7 +1462,7 @@ SolverResult run(Method method, Model& model, const SolverOptions& options,
       break;
     }
     case Method::newton: {
-      NewtonPolicy<Model> policy(model, options, ws, result);
+      NewtonPolicy<Model> policy(model, options, ws, result, tolerance);
       iterate(model, policy, monitor, options, hooks, result);
       break;
     }

@@ -1090,6 +1090,14 @@ void RunAccuracy::add(const StepInfo& step) {
         step.max_penetration);
 }
 
+double RunAccuracy::converged_percent() const {
+  return steps > 0 ? 100.0 * static_cast<double>(converged) / static_cast<double>(steps) : 100.0;
+}
+
+double RunAccuracy::mean_sweeps() const {
+  return steps > 0 ? static_cast<double>(sweeps) / static_cast<double>(steps) : 0.0;
+}
+
 double RunAccuracy::mean_overlap() const {
   return contacts > 0 ? overlap_sum / static_cast<double>(contacts) : 0.0;
 }
@@ -1101,12 +1109,8 @@ std::string RunAccuracy::describe() const {
     return std::string(text);
   };
   std::string s = "solver: " + std::to_string(converged) + " of " + std::to_string(steps) +
-                  " steps converged (" +
-                  number(steps > 0 ? 100.0 * static_cast<double>(converged) /
-                                         static_cast<double>(steps)
-                                   : 100.0) +
-                  " %), sweeps a step: mean " +
-                  number(steps > 0 ? static_cast<double>(sweeps) / static_cast<double>(steps) : 0.0) +
+                  " steps converged (" + number(converged_percent()) +
+                  " %), sweeps a step: mean " + number(mean_sweeps()) +
                   ", largest " + std::to_string(max_sweeps) + "; largest residual at exit " +
                   number(max_residual) + "\n";
   const auto both = [&](double x) {

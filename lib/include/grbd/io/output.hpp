@@ -262,6 +262,10 @@ struct RunAccuracy {
   void add(const timestep::StepReport& report);
   /// Counts one row of an output's /steps (which keeps no distribution).
   void add(const StepInfo& step);
+  /// The share of the steps whose solve met its tolerance [%] (100 without steps).
+  double converged_percent() const;
+  /// The sweeps a step, the mean (0 without steps).
+  double mean_sweeps() const;
   /// The mean overlap over the contacts [m] (0 without contacts).
   double mean_overlap() const;
   /// The 99th percentile of the overlaps [m] (the upper edge of its bin, ≤ 12 % above).
