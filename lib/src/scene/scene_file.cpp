@@ -7,6 +7,7 @@
 
 #include <toml++/toml.h>
 #include <algorithm>
+#include <array>
 #include <charconv>
 #include <cmath>
 #include <cstdio>
@@ -542,6 +543,19 @@ void read_simulation(TableReader& t, Scene& scene) {
   t.finish();
 }
 
+// The settings a scene gets where its [solver] table names nothing (chapter 7's table of keys;
+// chapter 6, "What a scene gets", measures them): SOR held to the natural-map residual 1e-4 at
+// α = 1.3, the gap-aware law's look-ahead of 0.1 r (no overlap recovery: it lifts a resting pile
+// and turns a silo's wall friction round) and Morton reordering every 100 steps. The library's own
+// StepSettings stay Moreau's scheme as derived (law off, the percussions' change).
+void scene_solver_defaults(timestep::StepSettings& s) {
+  s.solver.criterion = contact::Criterion::natural_residual;
+  s.solver.rel_tol = 1e-4;
+  s.solver.alpha = 1.3;
+  s.look_ahead = 0.1;
+  s.reorder_interval = 100;
+}
+
 void read_solver(TableReader& t, Scene& scene) {
   auto& s = scene.settings;
   s.method =
@@ -554,7 +568,8 @@ void read_solver(TableReader& t, Scene& scene) {
   s.solver.abs_tol = t.real("absolute_tolerance", s.solver.abs_tol, kNonNegative);
   s.solver.alpha = t.real("alpha", s.solver.alpha, Range{0.0, 2.0, true, true});
   s.solver.criterion = static_cast<contact::Criterion>(
-      t.choice("criterion", {"percussion_change", "velocity_change", "natural_residual"}, 0));
+      t.choice("criterion", {"percussion_change", "velocity_change", "natural_residual"},
+               static_cast<std::size_t>(s.solver.criterion)));
   s.solver.newton.linear_solver = static_cast<contact::LinearSolver>(
       t.choice("linear_solver", {"automatic", "direct", "gmres"}, 0));
   s.solver.newton.hybrid_sweeps =
@@ -567,7 +582,8 @@ void read_solver(TableReader& t, Scene& scene) {
   s.overlap_recovery = t.real("overlap_recovery", s.overlap_recovery, kUnit);
   s.max_recovery_speed = t.real("max_recovery_speed", s.max_recovery_speed, kPositive);
   s.look_ahead = t.real("look_ahead", s.look_ahead, kNonNegative);
-  s.reorder_interval = static_cast<int>(t.integer("reorder_interval", 100, 0, 1000000000));
+  s.reorder_interval =
+      static_cast<int>(t.integer("reorder_interval", s.reorder_interval, 0, 1000000000));
   s.orientation_update = static_cast<timestep::OrientationUpdate>(
       t.choice("orientation_update", {"exponential_map", "add_and_normalize"}, 0));
   t.finish();
@@ -803,11 +819,10 @@ Scene parse_scene(std::string_view text, const std::filesystem::path& file) {
     TableReader reader(*t, "simulation", name);
     read_simulation(reader, scene);
   }
+  scene_solver_defaults(scene.settings);
   if (const toml::table* t = top.table_opt("solver")) {
     TableReader reader(*t, "solver", name);
     read_solver(reader, scene);
-  } else {
-    scene.settings.reorder_interval = 100;
   }
   const toml::array* materials = top.tables_opt("material");
   if (materials == nullptr) top.missing("material", "at least one [[material]] with a name");
@@ -957,9 +972,25 @@ std::string summary(const Scene& scene) {
   out << "scene " << scene.file.string() << "\n";
   out << "  time: dt = " << scene.settings.dt << " s, end_time = " << scene.end_time << " s ("
       << scene.steps() << " steps), gravity = (" << scene.settings.I_g.transpose() << ") m/s²\n";
-  out << "  solver: " << contact::method_name(scene.settings.method) << ", tolerance "
-      << scene.settings.solver.rel_tol << ", at most " << scene.settings.solver.max_iterations
-      << " iterations" << (scene.settings.warm_start ? ", warm start" : "") << "\n";
+  const timestep::StepSettings& set = scene.settings;
+  constexpr std::array<std::string_view, 3> kCriteria = {"percussion change", "velocity change",
+                                                         "natural residual"};
+  out << "  solver: " << contact::method_name(set.method) << ", "
+      << kCriteria[static_cast<std::size_t>(set.solver.criterion)] << " tolerance "
+      << set.solver.rel_tol << ", alpha " << set.solver.alpha << ", at most "
+      << set.solver.max_iterations << " iterations" << (set.warm_start ? ", warm start" : "")
+      << "\n";
+  out << "  normal law: ";
+  if (set.look_ahead > 0.0 || set.overlap_recovery > 0.0) {
+    out << "gap-aware, look_ahead " << set.look_ahead << " r, overlap_recovery "
+        << set.overlap_recovery;
+    if (std::isfinite(set.max_recovery_speed)) {
+      out << ", max_recovery_speed " << set.max_recovery_speed << " m/s";
+    }
+    out << "\n";
+  } else {
+    out << "Moreau's (look_ahead and overlap_recovery 0)\n";
+  }
   if (scene.domain.any_periodic()) {
     out << "  periodic along";
     for (int d = 0; d < 3; ++d) {

@@ -164,6 +164,7 @@ void MoreauStepper::check_layout() {
     unit_ = smallest;
   }
   tolerance_ = std::max(settings_.contact_tolerance, settings_.look_ahead) * unit_;
+  moreau_tolerance_ = settings_.contact_tolerance * unit_;
   const auto body_name = [&](std::int64_t i) {
     return id_name(system_.ids()[static_cast<std::size_t>(i)]);
   };
@@ -291,8 +292,12 @@ void MoreauStepper::detect(const StepReport& report) {
     throw Error("MoreauStepper: step " + std::to_string(report.step) + " (t = " +
                 format_number(report.t) + " s): " + e.what());
   }
+  // Active: Moreau's set, and, within the look-ahead's reach, the contacts of inelastic pairs
+  // (ε_N = 0); a restituted pair must hit to rebound, so it keeps Moreau's law (chapter 6).
   keep_contacts_if(contacts_, keys_, [this](const DetectedContact& c) {
-    return is_active(c.geometry, tolerance_);
+    if (!is_active(c.geometry, tolerance_)) return false;
+    return tolerance_ == moreau_tolerance_ || is_active(c.geometry, moreau_tolerance_) ||
+           materials_.pair_unchecked(c.material_a, c.material_b).eps_N == 0.0;
   });
   if (hooks_.after_detection) {
     hooks_.after_detection(system_, contacts_, keys_);
@@ -344,9 +349,9 @@ void MoreauStepper::assemble(StepReport& report) {
       const double v_R = std::min(recovery * -c.geometry.g_N, settings_.max_recovery_speed);
       cc.xi_A(0) = std::min(cc.xi_A(0), -v_R);
     }
-    // The look-ahead: a contact still apart at the midpoint may close its gap by the next
-    // midpoint, γ_N,E ≥ −g_N(q_M)/Δt, and is not restituted (it has not hit).
-    if (settings_.look_ahead > 0.0 && c.geometry.g_N > 0.0) {
+    // The look-ahead: a contact of an inelastic pair still apart at the midpoint may close its
+    // gap by the next midpoint, γ_N,E ≥ −g_N(q_M)/Δt, and is not restituted (it has not hit).
+    if (settings_.look_ahead > 0.0 && c.geometry.g_N > 0.0 && law.eps_N == 0.0) {
       cc.xi_A(0) = c.geometry.g_N / settings_.dt;
     }
     // [gap law]

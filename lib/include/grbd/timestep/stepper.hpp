@@ -88,7 +88,8 @@ struct StepSettings {
   /// look_ahead × tolerance_radius are active, and one with a positive gap g_N(q_M) may approach
   /// by that gap until the next step's midpoint and no further, γ_N,E ≥ −g_N(q_M)/Δt (Stewart and
   /// Trinkle 1996), without restitution: an impact then starts at the next midpoint with the
-  /// bodies touching instead of overlapping by up to |γ_N| Δt.
+  /// bodies touching instead of overlapping by up to |γ_N| Δt. Inelastic pairs only (ε_N = 0): a
+  /// pair with restitution must hit to rebound, so it keeps Moreau's law and its active set.
   double look_ahead = 0.0;
 };
 
@@ -260,7 +261,8 @@ class MoreauStepper {
   std::uint64_t steps_ = 0;
   std::uint64_t non_converged_ = 0;
   std::uint64_t checked_layout_ = ~std::uint64_t{0};
-  double tolerance_ = 0.0;  // contact_tolerance × tolerance_radius [m]
+  double tolerance_ = 0.0;  // max(contact_tolerance, look_ahead) × tolerance_radius [m]
+  double moreau_tolerance_ = 0.0;  // contact_tolerance × tolerance_radius [m]
   double unit_ = 0.0;       // tolerance_radius, or the smallest first radius [m]
 
   std::vector<body::Loads> loads_;
