@@ -558,8 +558,7 @@ void scene_solver_defaults(timestep::StepSettings& s) {
 
 void read_solver(TableReader& t, Scene& scene) {
   auto& s = scene.settings;
-  s.method =
-      static_cast<contact::Method>(t.choice("method", {"sor", "jor", "apgd", "newton"}, 0));
+  s.method = static_cast<contact::Method>(t.choice("method", {"sor", "jor", "apgd", "newton"}, 0));
   s.solver.max_iterations =
       static_cast<int>(t.integer("max_iterations", s.solver.max_iterations, 1, 100000000));
   s.solver.min_iterations = static_cast<int>(
@@ -972,20 +971,20 @@ std::string summary(const Scene& scene) {
   out << "scene " << scene.file.string() << "\n";
   out << "  time: dt = " << scene.settings.dt << " s, end_time = " << scene.end_time << " s ("
       << scene.steps() << " steps), gravity = (" << scene.settings.I_g.transpose() << ") m/s²\n";
-  const timestep::StepSettings& set = scene.settings;
+  const timestep::StepSettings& settings = scene.settings;
   constexpr std::array<std::string_view, 3> kCriteria = {"percussion change", "velocity change",
                                                          "natural residual"};
-  out << "  solver: " << contact::method_name(set.method) << ", "
-      << kCriteria[static_cast<std::size_t>(set.solver.criterion)] << " tolerance "
-      << set.solver.rel_tol << ", alpha " << set.solver.alpha << ", at most "
-      << set.solver.max_iterations << " iterations" << (set.warm_start ? ", warm start" : "")
-      << "\n";
+  out << "  solver: " << contact::method_name(settings.method) << ", "
+      << kCriteria[static_cast<std::size_t>(settings.solver.criterion)] << " tolerance "
+      << settings.solver.rel_tol << ", alpha " << settings.solver.alpha << ", at most "
+      << settings.solver.max_iterations << " iterations"
+      << (settings.warm_start ? ", warm start" : "") << "\n";
   out << "  normal law: ";
-  if (set.look_ahead > 0.0 || set.overlap_recovery > 0.0) {
-    out << "gap-aware, look_ahead " << set.look_ahead << " r, overlap_recovery "
-        << set.overlap_recovery;
-    if (std::isfinite(set.max_recovery_speed)) {
-      out << ", max_recovery_speed " << set.max_recovery_speed << " m/s";
+  if (settings.look_ahead > 0.0 || settings.overlap_recovery > 0.0) {
+    out << "gap-aware, look_ahead " << settings.look_ahead << " r, overlap_recovery "
+        << settings.overlap_recovery;
+    if (std::isfinite(settings.max_recovery_speed)) {
+      out << ", max_recovery_speed " << settings.max_recovery_speed << " m/s";
     }
     out << "\n";
   } else {
