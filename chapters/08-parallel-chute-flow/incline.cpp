@@ -310,11 +310,13 @@ void measure_all(const std::filesystem::path& dir, const grbd::scene::Scene& bas
     }
     values.set(k + "energy_change", "%+.0f", changes[f]);
     values.set(k + "minutes", "%.1f", flow.seconds / 60.0);
-    values.set(k + "penetration_mm", "%.2f", flow.penetration * 1e3);
+    // Overlaps in µm to two significant digits: converged solves with the look-ahead leave
+    // fractions of a µm, Moreau's law tens of µm.
+    values.set(k + "penetration_um", "%.2g", flow.penetration * 1e6);
     values.set(k + "sweeps", "%.0f", flow.sweeps);
     values.set(k + "converged", "%.0f", flow.converged);
-    values.set(k + "mean_overlap_um", "%.1f", flow.mean_overlap * 1e6);
-    values.set(k + "p99_overlap_um", "%.0f", flow.p99_overlap * 1e6);
+    values.set(k + "mean_overlap_um", "%.2g", flow.mean_overlap * 1e6);
+    values.set(k + "p99_overlap_um", "%.2g", flow.p99_overlap * 1e6);
   }
   study.finish();
   std::string rest;
