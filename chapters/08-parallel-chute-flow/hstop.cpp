@@ -67,6 +67,7 @@ struct Measured {
   double fastest = 0.0;  // in the last record [m/s]
   double energy_change = 0.0;  // of the kinetic energy over the second half [%]
   State state = State::rest;
+  grbd::io::RunAccuracy accuracy;  // of the whole run (chapter 6, "Accuracy of a step")
 };
 
 Measured measure(const std::filesystem::path& file, const grbd::scene::Scene& scene,
@@ -91,6 +92,7 @@ Measured measure(const std::filesystem::path& file, const grbd::scene::Scene& sc
     m.state = State::creeping;
   }
   const std::vector<grbd::io::StepInfo> steps = grbd::io::read_steps(file);
+  for (const auto& s : steps) m.accuracy.add(s);
   for (const auto& s : steps) {
     if (s.step % 25 == 0) {
       energy << m.name << ',' << layer.angle << ',' << m.depth_d << ',' << s.t << ','
@@ -152,6 +154,9 @@ void measure_all(const std::filesystem::path& dir, const grbd::scene::Scene& bas
     values.set(k + "froude", "%.2f", m.froude);
     values.set(k + "state", "%s", state_name(m.state));
     values.set(k + "energy_change", "%+.0f", m.energy_change);
+    values.set(k + "converged", "%.0f", m.accuracy.converged_percent());
+    values.set(k + "sweeps", "%.0f", m.accuracy.mean_sweeps());
+    values.set(k + "largest_um", "%.2g", m.accuracy.max_overlap * 1e6);
     all.push_back(m);
   }
   energy.finish();
