@@ -29,6 +29,7 @@
 #include "grbd/scene/measure.hpp"
 #include "grbd/scene/scene.hpp"
 #include "grbd/scene/simulation.hpp"
+#include "grbd_demo/accuracy.hpp"
 #include "grbd_demo/demo.hpp"
 
 namespace {
@@ -197,11 +198,7 @@ int main(int argc, char** argv) {
       values.set(key + "rho_b", "%.0f", r.rho_b);
       values.set(key + "literature", "%.1f", literature * 1e3);
       values.set(key + "ratio", "%.2f", r.W.rate / literature);
-      const grbd::io::RunAccuracy& a = r.accuracy;
-      values.set(key + "converged", "%.0f", a.converged_percent());
-      values.set(key + "sweeps", "%.0f", a.mean_sweeps());
-      values.set(key + "p99", "%.1f", 1e6 * a.p99_overlap());
-      values.set(key + "largest", "%.0f", 1e6 * a.max_overlap);
+      grbd::demo::set_accuracy(values, key, r.accuracy);
       worst = std::max(worst, std::abs(r.W.rate / literature - 1.0));
     }
     values.set("C", "%.2f", fit.C);

@@ -22,6 +22,7 @@
 #include "grbd/scene/measure.hpp"
 #include "grbd/scene/scene.hpp"
 #include "grbd/scene/simulation.hpp"
+#include "grbd_demo/accuracy.hpp"
 #include "grbd_demo/demo.hpp"
 
 namespace {
@@ -182,11 +183,7 @@ int main(int argc, char** argv) {
       values.set(std::string(key) + "beads", "%zu", h.beads);
       values.set(std::string(key) + "rest", "%.2f", h.rest);
       values.set(std::string(key) + "fastest", "%s", grbd::demo::tex_power(h.max_speed).c_str());
-      const grbd::io::RunAccuracy& a = h.accuracy;
-      values.set(std::string(key) + "converged", "%.0f", a.converged_percent());
-      values.set(std::string(key) + "sweeps", "%.0f", a.mean_sweeps());
-      values.set(std::string(key) + "p99", "%.1f", 1e6 * a.p99_overlap());
-      values.set(std::string(key) + "largest", "%.0f", 1e6 * a.max_overlap);
+      grbd::demo::set_accuracy(values, key, h.accuracy);
       if (h.mu >= 0.3) {
         lo = std::min(lo, h.fit.angle);
         hi = std::max(hi, h.fit.angle);

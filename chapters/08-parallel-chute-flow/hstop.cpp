@@ -92,8 +92,8 @@ Measured measure(const std::filesystem::path& file, const grbd::scene::Scene& sc
     m.state = State::creeping;
   }
   const std::vector<grbd::io::StepInfo> steps = grbd::io::read_steps(file);
-  for (const auto& s : steps) m.accuracy.add(s);
   for (const auto& s : steps) {
+    m.accuracy.add(s);
     if (s.step % 25 == 0) {
       energy << m.name << ',' << layer.angle << ',' << m.depth_d << ',' << s.t << ','
              << s.kinetic_energy / static_cast<double>(s.bodies) << '\n';
