@@ -351,6 +351,22 @@ TEST(CompactProblem, TheReportIsTheResidualOfTheReturnedPercussions) {
     for (const Vector3& v : c) sum += v.squaredNorm();
     EXPECT_NEAR(result.norm_c, std::sqrt(sum), 1e-14 * std::sqrt(sum)) << method_name(method);
   }
+  // A caller's reference (the stepper's, without the look-ahead's gap rates) is the criterion's:
+  // the same solve held to 10⁻⁶ of a reference a thousand times smaller needs more sweeps.
+  Random held = r;
+  SolverOptions options;
+  options.criterion = Criterion::natural_residual;
+  options.rel_tol = 1e-6;
+  options.max_iterations = 100000;
+  ContactSolution plain_solution, held_solution;
+  const SolverResult plain = ContactSolver(Method::sor, options).solve(r.problem, plain_solution);
+  held.problem.reference_norm = 1e-3 * plain.norm_c;
+  const SolverResult tight = ContactSolver(Method::sor, options).solve(held.problem, held_solution);
+  EXPECT_EQ(tight.norm_c, held.problem.reference_norm);
+  ASSERT_TRUE(plain.converged && tight.converged);
+  EXPECT_LE(tight.residual, 1e-6 * tight.norm_c);
+  EXPECT_GT(plain.residual, 1e-6 * tight.norm_c) << "the plain solve stopped earlier";
+  EXPECT_GT(tight.iterations, plain.iterations);
 }
 
 TEST(CompactProblem, ValidationNamesTheBadEntry) {

@@ -697,6 +697,14 @@ TEST(Stepper, RefusesBadSettingsMissingMaterialPairsAndUnsupportedShapePairs) {
   bad.look_ahead = -1.0;
   EXPECT_THROW(MoreauStepper(system, statics, materials, bad), InvalidArgument);
   bad = {};
+  bad.look_ahead_reach = 1.0;  // a reach without a look-ahead to extend
+  EXPECT_THROW(MoreauStepper(system, statics, materials, bad), InvalidArgument);
+  bad.look_ahead = 0.5;  // shorter than the look-ahead
+  bad.look_ahead_reach = 0.2;
+  EXPECT_THROW(MoreauStepper(system, statics, materials, bad), InvalidArgument);
+  bad.look_ahead_reach = std::numeric_limits<double>::infinity();
+  EXPECT_THROW(MoreauStepper(system, statics, materials, bad), InvalidArgument);
+  bad = {};
   bad.skin = -1e-3;
   EXPECT_THROW(MoreauStepper(system, statics, materials, bad), InvalidArgument);
   materials.set_pair(1, 1, {0.5, 0.0, 0.0});
@@ -1022,6 +1030,81 @@ TEST(GapLaw, TheLookAheadLeavesARestitutedPairToMoreausLaw) {
   ASSERT_GE(off.impacts.size(), 8u);
   EXPECT_EQ(on.impacts, off.impacts);
   EXPECT_FALSE(on.energy_increased) << "relative gain " << on.worst_gain;
+}
+
+// The look-ahead's reach (The gap-aware normal law): two balls closing head-on at 2 m/s, 2 mm a
+// step, with a look-ahead of 0.1 mm. Without a reach the first midpoint within the look-ahead
+// finds them already overlapping, by up to 2 mm less the look-ahead; with a reach of 5 mm the step
+// whose free velocities close the gap to the look-ahead takes them in, and they meet touching
+// (to round-off) and stop along the line of centres, an inelastic impact, while their common
+// sliding across it is untouched. A pair within the reach that moves apart stays out of the
+// active set.
+TEST(GapLaw, TheReachCatchesAPairClosingByMoreThanTheLookAheadAStep) {
+  const double r = 0.1;
+  const auto collide = [&](double reach, double speed) {
+    BodySystem system;
+    system.add(sphere_body(1, r, Vector3(-r - 0.0253, 0.0, 0.0)));
+    system.add(sphere_body(2, r, Vector3(r + 0.0253, 0.0, 0.0)));
+    system.states()[0].u(0) = speed;
+    system.states()[1].u(0) = -speed;
+    system.states()[0].u(1) = system.states()[1].u(1) = 0.5;  // sliding past along y as well
+    StaticGeometry statics;
+    const MaterialTable materials = demo::one_material(0.0, 0.0);
+    StepSettings settings = tight(1e-3);
+    settings.I_g.setZero();
+    settings.look_ahead = 0.001;  // 0.1 mm
+    settings.look_ahead_reach = reach;
+    MoreauStepper stepper(system, statics, materials, settings);
+    double overlap = 0.0;
+    std::size_t contacts = 0;
+    for (int k = 0; k < 40; ++k) {
+      const StepReport report = stepper.step();
+      overlap = std::max(overlap, report.max_penetration);
+      contacts = std::max(contacts, report.contacts);
+    }
+    const double momentum = (system.states()[0].u + system.states()[1].u).head<3>().norm();
+    return std::tuple{overlap, contacts, momentum, system.states()[0].u(0)};
+  };
+  const auto [off, off_contacts, off_momentum, off_speed] = collide(0.0, 1.0);
+  EXPECT_GT(off, 1e-4) << "the look-ahead alone lets the pair in";
+  const auto [on, on_contacts, on_momentum, on_speed] = collide(0.05, 1.0);
+  EXPECT_EQ(on_contacts, 1u);
+  EXPECT_LT(on, 1e-14) << "the reach takes the pair in before it overlaps";
+  EXPECT_NEAR(on_momentum, 1.0, 1e-12) << "the sliding along y is untouched (mu = 0)";
+  EXPECT_LT(std::abs(on_speed), 1e-12) << "an inelastic impact: the pair stops along x";
+  EXPECT_LT(std::abs(off_speed), 1e-12);
+  // Moving apart within the reach: never active.
+  const auto [apart, apart_contacts, apart_momentum, apart_speed] = collide(1.0, -1.0);
+  EXPECT_EQ(apart_contacts, 0u);
+  EXPECT_EQ(apart, 0.0);
+}
+
+// The criterion's reference with the look-ahead (The gap-aware normal law): a sphere resting on
+// the floor and one hovering 5 mm above it, within the look-ahead. The hovering one's gap rate
+// g/Δt = 5 m/s is a length over a step, not a velocity of the motion: the reference of the
+// natural residual is that of the free contact velocities alone, −gΔt for each (√2 g Δt), where
+// with the gap rate it would be 5 m/s and the tolerance 500 times looser.
+TEST(GapLaw, TheLookAheadsGapRatesAreNotPartOfTheCriterionsReference) {
+  const double r = 0.1;
+  const double dt = 1e-3;
+  BodySystem system;
+  system.add(sphere_body(1, r, Vector3(0.0, 0.0, r)));
+  system.add(sphere_body(2, r, Vector3(1.0, 0.0, r + 0.005 + 0.5 * dt * dt * kG)));
+  StaticGeometry statics;
+  statics.add(demo::floor_object());
+  const MaterialTable materials = demo::one_material(0.3, 0.0);
+  StepSettings settings = tight(dt);
+  settings.look_ahead = 0.1;  // 1 cm
+  MoreauStepper stepper(system, statics, materials, settings);
+  const StepReport report = stepper.step();
+  ASSERT_EQ(report.contacts, 2u);
+  EXPECT_NEAR(stepper.problem().reference_norm, std::sqrt(2.0) * kG * dt, 1e-12);
+  settings.look_ahead = 0.0;  // Moreau's law: the solver's own ‖c‖
+  BodySystem moreau_system;
+  moreau_system.add(sphere_body(1, r, Vector3(0.0, 0.0, r)));
+  MoreauStepper moreau(moreau_system, statics, materials, settings);
+  moreau.step();
+  EXPECT_EQ(moreau.problem().reference_norm, 0.0);
 }
 
 // The overlaps' histogram (Accuracy of a step): bins of 10^(1/20) from 1e-8 r to r, quantiles

@@ -516,6 +516,9 @@ class CompactModel {
   /// The last sweep's verdict on the percussion criterion.
   bool sweep_settled() const { return sweep_.settled; }
 
+  /// The caller's reference ‖c‖ (CompactProblem::reference_norm; 0: none).
+  double reference_norm() const { return problem_.reference_norm; }
+
   /// One pass over the contacts instead of three (start_solve()): r-factors from the diagonal of
   /// G_ii (when r is given), c_i = ξ_i(0) for ‖c‖, and the initial percussions added to
   /// u = u_free + M⁻¹ W Λ. A sum of squares that is zero or out of range goes to the careful
@@ -1420,6 +1423,9 @@ SolverResult run(Method method, Model& model, const SolverOptions& options,
     if (!per_contact) compute_r_factors(model, strategy, options.alpha, ws);
   }
   result.norm_c = model.prepare(per_contact ? &ws.r : nullptr, options.alpha);
+  if constexpr (requires { model.reference_norm(); }) {
+    if (model.reference_norm() > 0.0) result.norm_c = model.reference_norm();
+  }
   // SOR on a model whose sweep can test its own change needs no copy of Λ per iteration, unless
   // a hook may change Λ between the sweep and the test.
   bool change_in_sweep = false;

@@ -553,6 +553,7 @@ void scene_solver_defaults(timestep::StepSettings& s) {
   s.solver.rel_tol = 1e-4;
   s.solver.alpha = 1.3;
   s.look_ahead = 0.1;
+  s.look_ahead_reach = 1.0;
   s.reorder_interval = 100;
 }
 
@@ -581,6 +582,19 @@ void read_solver(TableReader& t, Scene& scene) {
   s.overlap_recovery = t.real("overlap_recovery", s.overlap_recovery, kUnit);
   s.max_recovery_speed = t.real("max_recovery_speed", s.max_recovery_speed, kPositive);
   s.look_ahead = t.real("look_ahead", s.look_ahead, kNonNegative);
+  // The reach extends the look-ahead: where a scene does not name it, it is 0 without a
+  // look-ahead and at least the look-ahead with one.
+  if (const toml::node* reach = t.get("look_ahead_reach")) {
+    s.look_ahead_reach = t.real("look_ahead_reach", s.look_ahead_reach, kNonNegative);
+    if (s.look_ahead_reach != 0.0 && !(s.look_ahead > 0.0 && s.look_ahead_reach >= s.look_ahead)) {
+      std::ostringstream expected;
+      expected << "0 (none) or, with a look_ahead > 0, at least the look_ahead (" << s.look_ahead
+               << ")";
+      t.fail(*reach, "look_ahead_reach", expected.str());
+    }
+  } else {
+    s.look_ahead_reach = s.look_ahead == 0.0 ? 0.0 : std::max(s.look_ahead_reach, s.look_ahead);
+  }
   s.reorder_interval =
       static_cast<int>(t.integer("reorder_interval", s.reorder_interval, 0, 1000000000));
   s.orientation_update = static_cast<timestep::OrientationUpdate>(
@@ -981,8 +995,11 @@ std::string summary(const Scene& scene) {
       << (settings.warm_start ? ", warm start" : "") << "\n";
   out << "  normal law: ";
   if (settings.look_ahead > 0.0 || settings.overlap_recovery > 0.0) {
-    out << "gap-aware, look_ahead " << settings.look_ahead << " r, overlap_recovery "
-        << settings.overlap_recovery;
+    out << "gap-aware, look_ahead " << settings.look_ahead << " r";
+    if (settings.look_ahead_reach > settings.look_ahead) {
+      out << ", reach " << settings.look_ahead_reach << " r for approaching pairs";
+    }
+    out << ", overlap_recovery " << settings.overlap_recovery;
     if (std::isfinite(settings.max_recovery_speed)) {
       out << ", max_recovery_speed " << settings.max_recovery_speed << " m/s";
     }

@@ -60,6 +60,12 @@ void require_settings(const StepSettings& s) {
     throw InvalidArgument(where + "expected a finite look_ahead >= 0 (0: off), found " +
                           format_number(s.look_ahead));
   }
+  if (!std::isfinite(s.look_ahead_reach) ||
+      !(s.look_ahead_reach == 0.0 || (s.look_ahead > 0.0 && s.look_ahead_reach >= s.look_ahead))) {
+    throw InvalidArgument(where + "expected a finite look_ahead_reach, 0 (none) or, with a " +
+                          "look_ahead > 0, at least the look_ahead (" + format_number(s.look_ahead) +
+                          "), found " + format_number(s.look_ahead_reach));
+  }
   if (!(s.max_recovery_speed > 0.0)) {
     throw InvalidArgument(where + "expected max_recovery_speed > 0 [m/s] (may be infinite), found " +
                           format_number(s.max_recovery_speed));
@@ -163,7 +169,8 @@ void MoreauStepper::check_layout() {
   } else if (unit_ == 0.0 && n > 0) {
     unit_ = smallest;
   }
-  tolerance_ = std::max(settings_.contact_tolerance, settings_.look_ahead) * unit_;
+  near_tolerance_ = std::max(settings_.contact_tolerance, settings_.look_ahead) * unit_;
+  tolerance_ = std::max(near_tolerance_, settings_.look_ahead_reach * unit_);
   moreau_tolerance_ = settings_.contact_tolerance * unit_;
   const auto body_name = [&](std::int64_t i) {
     return id_name(system_.ids()[static_cast<std::size_t>(i)]);
@@ -292,13 +299,30 @@ void MoreauStepper::detect(const StepReport& report) {
     throw Error("MoreauStepper: step " + std::to_string(report.step) + " (t = " +
                 format_number(report.t) + " s): " + e.what());
   }
-  // Active: Moreau's set, and, within the look-ahead's reach, the contacts of inelastic pairs
-  // (ε_N = 0); a restituted pair must hit to rebound, so it keeps Moreau's law (chapter 6).
-  keep_contacts_if(contacts_, keys_, [this](const DetectedContact& c) {
+  // Active: Moreau's set, and, within the look-ahead, the contacts of inelastic pairs (ε_N = 0);
+  // a restituted pair must hit to rebound, so it keeps Moreau's law (chapter 6). Beyond the
+  // look-ahead, within its reach, an inelastic pair whose free velocities close it to the
+  // look-ahead by the next midpoint, g_N + Δt γ_N,free ≤ look-ahead.
+  // [reach]
+  const auto states = system_.states();
+  const auto free_approach = [&](const DetectedContact& c) {
+    const auto velocity = [&](collision::BodyIndex body, const Vector3& I_r) -> Vector3 {
+      if (body == collision::kStatic) return Vector3::Zero();
+      const auto i = static_cast<std::size_t>(body);
+      const Vector6& u = problem_.u_free[i];
+      return u.head<3>() + u.tail<3>().cross(I_r - states[i].q.head<3>());
+    };
+    return c.geometry.I_n.dot(velocity(c.body_a, c.geometry.I_r_a) -
+                              velocity(c.body_b, c.geometry.I_r_b));
+  };
+  keep_contacts_if(contacts_, keys_, [&](const DetectedContact& c) {
     if (!is_active(c.geometry, tolerance_)) return false;
-    return tolerance_ == moreau_tolerance_ || is_active(c.geometry, moreau_tolerance_) ||
-           materials_.pair_unchecked(c.material_a, c.material_b).eps_N == 0.0;
+    if (tolerance_ == moreau_tolerance_ || is_active(c.geometry, moreau_tolerance_)) return true;
+    if (materials_.pair_unchecked(c.material_a, c.material_b).eps_N != 0.0) return false;
+    return is_active(c.geometry, near_tolerance_) ||
+           c.geometry.g_N + settings_.dt * free_approach(c) <= near_tolerance_;
   });
+  // [reach]
   if (hooks_.after_detection) {
     hooks_.after_detection(system_, contacts_, keys_);
     if (keys_.size() != contacts_.size()) {
@@ -318,6 +342,8 @@ void MoreauStepper::assemble(StepReport& report) {
   const std::size_t m = contacts_.size();
   problem_.contacts.resize(m);
   const double recovery = 2.0 * settings_.overlap_recovery / settings_.dt;  // v_R per metre
+  const bool look_ahead = tolerance_ > moreau_tolerance_;
+  double reference = 0.0;  // Σ ‖γ_free + xi_A‖² without the look-ahead's gap rates
   for (std::size_t k = 0; k < m; ++k) {
     const DetectedContact& c = contacts_[k];
     contact::CompactContact& cc = problem_.contacts[k];
@@ -351,16 +377,24 @@ void MoreauStepper::assemble(StepReport& report) {
     }
     // The look-ahead: a contact of an inelastic pair still apart at the midpoint may close its
     // gap by the next midpoint, γ_N,E ≥ −g_N(q_M)/Δt, and is not restituted (it has not hit).
-    if (settings_.look_ahead > 0.0 && c.geometry.g_N > 0.0 && law.eps_N == 0.0) {
-      cc.xi_A(0) = c.geometry.g_N / settings_.dt;
-    }
+    const bool gap_rate = look_ahead && c.geometry.g_N > 0.0 && law.eps_N == 0.0;
+    if (gap_rate) cc.xi_A(0) = c.geometry.g_N / settings_.dt;
     // [gap law]
+    if (look_ahead) {
+      Vector3 c_free = contact::contact_velocity(cc, problem_.u_free) + cc.xi_A;
+      if (gap_rate) c_free(0) -= cc.xi_A(0);
+      reference += c_free.squaredNorm();
+    }
     if (!cc.xi_A.allFinite() || !cc.r_a.allFinite() || !cc.r_b.allFinite()) {
       throw Error("MoreauStepper: step " + std::to_string(report.step) + ": the contact of " +
                   id_name(keys_[k].a) + " and " + id_name(keys_[k].b) +
                   " has a non-finite lever arm or velocity");
     }
   }
+  // The criterion's reference leaves out the look-ahead's gap rates: a gap over a step is a
+  // length, not a velocity of the motion, and would loosen the tolerance with every contact
+  // about to close (0: the solver's own ‖c‖).
+  problem_.reference_norm = look_ahead ? std::sqrt(reference) : 0.0;
   solution_.lambda.resize(m);
   if (settings_.warm_start) {
     report.warm_started = warm_.initialize(keys_, solution_.lambda);

@@ -58,6 +58,10 @@ struct CompactProblem {
   /// (0, 0) entry instead of the matrix, 24 fewer operations per contact update. validate()
   /// checks it.
   bool isotropic = false;
+  /// The reference ‖c‖ of the natural-residual criterion when the caller sets it (> 0): the
+  /// stepper's, which leaves out the look-ahead's gap rates g_N/Δt of xi_A (chapter 6, \ref
+  /// ch06_gap_law) — a length over a step, not a velocity of the motion. 0: ‖Wᵀu_free + xi_A‖.
+  double reference_norm = 0.0;
 };
 
 /// Checks a compact problem before a solver touches it: body counts that agree, body indices in

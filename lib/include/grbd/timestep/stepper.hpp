@@ -91,6 +91,14 @@ struct StepSettings {
   /// bodies touching instead of overlapping by up to |γ_N| Δt. Inelastic pairs only (ε_N = 0): a
   /// pair with restitution must hit to rebound, so it keeps Moreau's law and its active set.
   double look_ahead = 0.0;
+  /// The reach of the look-ahead for approaching pairs, in units of tolerance_radius, finite and
+  /// 0 (none: look_ahead alone) or ≥ look_ahead (chapter 6, \ref ch06_gap_law): a contact of an
+  /// inelastic pair whose gap at the midpoint lies beyond look_ahead but within this reach is
+  /// active when the free velocities would close it to the look-ahead by the next midpoint,
+  /// g_N(q_M) + Δt γ_N,free ≤ look_ahead × tolerance_radius, and then obeys the same law. A pair
+  /// closing by more than the look-ahead in a step is caught before it lands, up to approach
+  /// speeds of (look_ahead_reach − look_ahead) × tolerance_radius / Δt.
+  double look_ahead_reach = 0.0;
 };
 
 /// Wall time of the stages of one step [s].
@@ -215,7 +223,8 @@ class MoreauStepper {
   const StepSettings& settings() const { return settings_; }
   /// The hooks.
   const StepHooks& hooks() const { return hooks_; }
-  /// The active-set tolerance contact_tolerance × tolerance_radius [m] (0 before any body).
+  /// The largest gap at which detection finds a contact [m]: the largest of contact_tolerance,
+  /// look_ahead and look_ahead_reach, times tolerance_radius (0 before any body).
   double active_set_tolerance() const { return tolerance_; }
   /// The length r that StepReport::overlaps counts in [m]: tolerance_radius, or the smallest
   /// bounding radius of the first bodies (0 before any body).
@@ -261,7 +270,8 @@ class MoreauStepper {
   std::uint64_t steps_ = 0;
   std::uint64_t non_converged_ = 0;
   std::uint64_t checked_layout_ = ~std::uint64_t{0};
-  double tolerance_ = 0.0;  // max(contact_tolerance, look_ahead) × tolerance_radius [m]
+  double tolerance_ = 0.0;  // max(contact_tolerance, look_ahead, reach) × tolerance_radius [m]
+  double near_tolerance_ = 0.0;    // max(contact_tolerance, look_ahead) × tolerance_radius [m]
   double moreau_tolerance_ = 0.0;  // contact_tolerance × tolerance_radius [m]
   double unit_ = 0.0;       // tolerance_radius, or the smallest first radius [m]
 
