@@ -92,9 +92,10 @@ inline timestep::GlobalId solving_side(const timestep::ContactKey& key) {
 }
 
 /// The margin of the ghosts [m]: a contact is detected within the largest of contact_tolerance,
-/// look_ahead and look_ahead_reach, times tolerance_radius, of a gap, and the candidate pairs stay valid while no body has moved more than
-/// half the skin: every body a process's bodies can touch before the next rebuild lies within its
-/// bounding radius, the largest one and this margin (BodyExchange, ParallelStepper).
+/// look_ahead and look_ahead_reach, times tolerance_radius, of a gap, and the candidate pairs stay
+/// valid while no body has moved more than half the skin: every body a process's bodies can touch
+/// before the next rebuild lies within its bounding radius, the largest one and this margin
+/// (BodyExchange, ParallelStepper).
 inline double ghost_margin(const timestep::StepSettings& settings) {
   return std::max({settings.contact_tolerance, settings.look_ahead, settings.look_ahead_reach}) *
              settings.tolerance_radius +
